@@ -1,0 +1,205 @@
+//! Self-checks of an atlas that the command line reports and the tests assert: how well the charts
+//! cover the surface, and how consistent the transition functions are.
+//!
+//! Tolerance policy: chart coordinates are O(1), so errors are absolute, in chart units. A
+//! representation closer than [`BOUNDARY_BAND`] to its chart's boundary may be found from one chart and
+//! not from another (rounding decides which side of the open boundary it falls); such
+//! representations are skipped when comparing, never counted as errors.
+
+use num_complex::Complex64;
+use serde::Serialize;
+
+use crate::{Atlas, ChartPoint, Geometry, ModelPoint};
+
+/// Representations this close to a chart boundary (chart units) are not compared.
+pub const BOUNDARY_BAND: f64 = 1e-9;
+
+/// The coverage of a set of points: the smallest margin and where it occurs.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Coverage {
+    pub points: usize,
+    /// min over points of (max over the point's charts of the distance to that chart's boundary).
+    pub min_margin: f64,
+    /// A point (in the model space) where the minimum occurs.
+    pub worst_point: Complex64,
+    /// The most charts any point lies in.
+    pub max_charts: usize,
+}
+
+/// Consistency of the transition functions over a set of points.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Consistency {
+    pub points: usize,
+    /// Largest |ψ_ii(w) − w| over the stored ψ_ii (they are the identity matrix).
+    pub identity_error: f64,
+    /// Largest |ψ_ji(ψ_ij(w)) − w|.
+    pub inverse_error: f64,
+    /// Largest |ψ_jk(ψ_ij(w)) − ψ_ik(w)| on triple overlaps.
+    pub cocycle_error: f64,
+    /// Representations (away from boundaries) that one chart's view found and another's missed.
+    pub missing: usize,
+}
+
+impl Consistency {
+    /// The largest of the three errors (infinite if any representation went missing).
+    pub fn worst(&self) -> f64 {
+        if self.missing > 0 {
+            return f64::INFINITY;
+        }
+        self.identity_error
+            .max(self.inverse_error)
+            .max(self.cocycle_error)
+    }
+
+    fn merge(&mut self, o: Consistency) {
+        self.points += o.points;
+        self.identity_error = self.identity_error.max(o.identity_error);
+        self.inverse_error = self.inverse_error.max(o.inverse_error);
+        self.cocycle_error = self.cocycle_error.max(o.cocycle_error);
+        self.missing += o.missing;
+    }
+}
+
+/// `count` model points spread over the whole surface, deterministically: for genus ≥ 2, uniform in
+/// the Klein model over the 4n triangles (origin, corner c, corner c+1), which reaches into the
+/// polygon's thin corners; for genus 1 uniform over the square; for genus 0 uniform on the sphere.
+/// The polygon's corners, edge midpoints and the point β come first.
+pub fn spread_points(atlas: &Atlas, count: usize) -> Vec<ModelPoint> {
+    let mut out = Vec::with_capacity(count);
+    if let Some(poly) = atlas.polygon() {
+        let c = poly.constants();
+        out.push(ModelPoint(Complex64::ZERO));
+        for (k, &corner) in poly.corners().iter().enumerate() {
+            out.push(ModelPoint(corner * (1.0 - 1e-12)));
+            out.push(ModelPoint(Complex64::from_polar(c.gamma, k as f64 * c.omega)));
+            out.push(ModelPoint(
+                c.beta * Complex64::from_polar(1.0, k as f64 * c.omega),
+            ));
+        }
+    }
+    let remaining = count.saturating_sub(out.len());
+    let seq = (0..remaining).map(r2);
+    match (atlas.geometry(), atlas.polygon()) {
+        (Geometry::Hyperbolic, Some(poly)) => {
+            let sides = poly.sides();
+            let klein: Vec<Complex64> = poly
+                .corners()
+                .iter()
+                .map(|&z| z * (2.0 / (1.0 + z.norm_sqr())))
+                .collect();
+            out.extend(seq.enumerate().map(|(i, (u, v))| {
+                let tri = i % sides;
+                let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                let k = klein[tri] * u + klein[(tri + 1) % sides] * v;
+                ModelPoint(k / (1.0 + (1.0 - k.norm_sqr()).max(0.0).sqrt()))
+            }));
+        }
+        (Geometry::Euclidean, _) => {
+            out.extend(seq.map(|(u, v)| ModelPoint(Complex64::new(u - 0.5, v - 0.5))));
+        }
+        _ => {
+            out.extend(seq.map(|(u, v)| {
+                let z = 2.0 * u - 1.0;
+                let rho = (1.0 - z * z).max(0.0).sqrt();
+                let (s, c) = (std::f64::consts::TAU * v).sin_cos();
+                // Stereographic projection from the north pole; z = 1 exactly never occurs.
+                ModelPoint(Complex64::new(rho * c, rho * s) / (1.0 - z).max(1e-300))
+            }));
+        }
+    }
+    out.truncate(count.max(out.len().min(count)));
+    out
+}
+
+/// The R2 low-discrepancy sequence (Roberts), well spread in the unit square for any prefix.
+fn r2(i: usize) -> (f64, f64) {
+    const G: f64 = 1.324_717_957_244_746; // the plastic number
+    let (a1, a2) = (1.0 / G, 1.0 / (G * G));
+    let k = i as f64 + 0.5;
+    ((k * a1).fract(), (k * a2).fract())
+}
+
+/// The coverage margin over `points`.
+pub fn coverage(atlas: &Atlas, points: &[ModelPoint]) -> Coverage {
+    let mut result = Coverage {
+        points: points.len(),
+        min_margin: f64::INFINITY,
+        worst_point: Complex64::ZERO,
+        max_charts: 0,
+    };
+    for &z in points {
+        let p = atlas.locate_model(z);
+        let m = atlas.margin(&p);
+        result.max_charts = result.max_charts.max(p.representations().len());
+        if m < result.min_margin {
+            result.min_margin = m;
+            result.worst_point = z.0;
+        }
+    }
+    result
+}
+
+/// Compares the views of one surface point from each of its charts: locating it from any
+/// representation must give every other representation (inverse and cocycle conditions).
+pub fn consistency_at(atlas: &Atlas, p: ChartPoint) -> Consistency {
+    let mut out = Consistency {
+        points: 1,
+        ..Consistency::default()
+    };
+    let Ok(base) = atlas.locate(p) else {
+        return out;
+    };
+    let margin = |r: &ChartPoint| {
+        atlas
+            .chart(r.chart)
+            .map(|c| c.domain().margin(r.coords))
+            .unwrap_or(f64::NEG_INFINITY)
+    };
+    for via in base.representations().iter().filter(|r| r.chart != p.chart) {
+        if margin(via) < BOUNDARY_BAND {
+            continue;
+        }
+        let again = atlas.locate_unchecked(*via);
+        for x in base.representations().iter().filter(|x| x.chart != via.chart) {
+            if margin(x) < BOUNDARY_BAND {
+                continue;
+            }
+            match again.in_chart(x.chart) {
+                None => out.missing += 1,
+                Some(w) => {
+                    let err = (w - x.coords).norm();
+                    if x.chart == p.chart {
+                        out.inverse_error = out.inverse_error.max(err);
+                    } else {
+                        out.cocycle_error = out.cocycle_error.max(err);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The full self-check over `points`: ψ_ii, and inverse/cocycle errors seen from each point's first
+/// chart.
+pub fn consistency(atlas: &Atlas, points: &[ModelPoint]) -> Consistency {
+    let mut total = Consistency::default();
+    for chart in atlas.charts() {
+        let id = chart.id();
+        for t in atlas.transitions(id, id) {
+            let w = Complex64::new(0.3, -0.2);
+            total.identity_error = total.identity_error.max((t.apply(w) - w).norm());
+        }
+    }
+    for &z in points {
+        let p = atlas.locate_model(z);
+        // Start from the representation deepest in its chart, so that it is a valid chart point.
+        if let Some(start) = p.representations().iter().max_by(|a, b| {
+            let m = |r: &&ChartPoint| atlas.charts()[r.chart.index()].domain().margin(r.coords);
+            m(a).total_cmp(&m(b))
+        }) {
+            total.merge(consistency_at(atlas, *start));
+        }
+    }
+    total
+}
