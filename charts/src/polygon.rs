@@ -74,6 +74,23 @@ pub struct VertexStep {
 }
 
 impl Polygon {
+    /// The fundamental polygon for genus 1 ..= [`crate::MAX_GENUS`] (genus 0 has none).
+    ///
+    /// ```
+    /// let octagon = charts::Polygon::new(2).unwrap();
+    /// assert!((octagon.constants().alpha - 2f64.powf(-0.25)).abs() < 1e-15);
+    /// ```
+    pub fn new(genus: u32) -> Result<Polygon, crate::ChartsError> {
+        match genus {
+            1 => Ok(Polygon::square()),
+            n if (2..=crate::MAX_GENUS).contains(&n) => Ok(Polygon::hyperbolic(n)),
+            _ => Err(crate::ChartsError::UnsupportedGenus {
+                genus,
+                max: crate::MAX_GENUS,
+            }),
+        }
+    }
+
     /// The regular hyperbolic 4n-gon with interior angles 2π/4n, for n ≥ 2.
     ///
     /// Closed forms (derived from the paper's h² = (1 + cos ω)/(2 cos ω), r² = h² − 1): with
@@ -247,6 +264,20 @@ impl Polygon {
     /// The 4n steps around the single surface vertex, starting at corner 0 and leaving by edge 1.
     pub fn vertex_cycle(&self) -> &[VertexStep] {
         &self.vertex_cycle
+    }
+
+    /// The product, over the walk around the vertex, of the maps onto the tiles crossed into:
+    /// cross[e₀]·cross[e₁]·…·cross[e₄ₙ₋₁]. It is the defining relation of the group, so it must be the
+    /// identity. Formed in double-double and rounded once; `naive` forms it in f64 instead (which
+    /// loses ~12 digits at n = 64, the reason the atlas uses DD).
+    pub fn vertex_composite(&self, naive: bool) -> crate::Lft {
+        if naive {
+            self.vertex_cycle
+                .iter()
+                .fold(crate::Lft::IDENTITY, |acc, s| acc.compose(&self.cross_f64[s.leave_by]))
+        } else {
+            dd::product(self.vertex_cycle.iter().map(|s| &self.cross[s.leave_by])).to_lft()
+        }
     }
 
     /// T(p) in this geometry: the translation along the real axis taking 0 to p.

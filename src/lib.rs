@@ -1,0 +1,9 @@
+//! # ntori
+//!
+//! The application layer: the command line (and, in later work, the model file, meshes, export, the
+//! renderer and the editor) over the [`charts`] and [`embedding`] crates.
+
+pub mod info;
+
+pub use charts;
+pub use embedding;
