@@ -142,7 +142,10 @@ fn overlap_reports(atlas: &Atlas) -> Vec<OverlapReport> {
         BTreeMap::new();
     for c in atlas.charts() {
         for (j, k) in others(atlas, c.id()) {
-            let key = (kind_class(c.kind()), kind_class(atlas.charts()[j.index()].kind()));
+            let key = (
+                kind_class(c.kind()),
+                kind_class(atlas.charts()[j.index()].kind()),
+            );
             *by_kind.entry(key).or_default().entry(k).or_default() += 1;
         }
     }
@@ -163,27 +166,59 @@ impl InfoReport {
         let mut s = String::new();
         let geometry = match self.geometry {
             Geometry::Spherical => "spherical: the Riemann sphere, two caps glued by an inversion",
-            Geometry::Euclidean => "Euclidean: the unit square, opposite sides glued by translations",
+            Geometry::Euclidean => {
+                "Euclidean: the unit square, opposite sides glued by translations"
+            }
             Geometry::Hyperbolic => "hyperbolic: a regular 4n-gon in the Poincaré disk",
         };
-        let _ = writeln!(s, "genus {} ({geometry}); Euler characteristic {}", self.genus, self.euler_characteristic);
+        let _ = writeln!(
+            s,
+            "genus {} ({geometry}); Euler characteristic {}",
+            self.genus, self.euler_characteristic
+        );
         if let Some(p) = &self.polygon {
             self.polygon_text(&mut s, p);
         }
-        let _ = writeln!(s, "\nCharts ({}; disks have radius ½, squares half-width ½):", self.charts.len());
-        let _ = writeln!(s, "  {:>3}  {:<8} {:<7} {:>5} {:>11} {:>11}", "id", "chart", "domain", "tiles", "neighbours", "components");
+        let _ = writeln!(
+            s,
+            "\nCharts ({}; disks have radius ½, squares half-width ½):",
+            self.charts.len()
+        );
+        let _ = writeln!(
+            s,
+            "  {:>3}  {:<8} {:<7} {:>5} {:>11} {:>11}",
+            "id", "chart", "domain", "tiles", "neighbours", "components"
+        );
         for c in &self.charts {
             let domain = match c.domain {
                 charts::Domain::Disk => "disk",
                 charts::Domain::Square => "square",
             };
-            let _ = writeln!(s, "  {:>3}  {:<8} {:<7} {:>5} {:>11} {:>11}", c.id, c.label, domain, c.tiles, c.neighbours, c.components);
+            let _ = writeln!(
+                s,
+                "  {:>3}  {:<8} {:<7} {:>5} {:>11} {:>11}",
+                c.id, c.label, domain, c.tiles, c.neighbours, c.components
+            );
         }
         let _ = writeln!(s, "  scales: {}", scales_text(&self.scales));
-        let _ = writeln!(s, "\nOverlaps U_ij (ordered pairs i ≠ j), split into connected components:");
+        let _ = writeln!(
+            s,
+            "\nOverlaps U_ij (ordered pairs i ≠ j), split into connected components:"
+        );
         for o in &self.overlaps {
-            let hist: Vec<String> = o.components_per_pair.iter().map(|(k, n)| format!("{n} with {k}")).collect();
-            let _ = writeln!(s, "  {:>6} → {:<6} {:>5} pairs: {}", o.from, o.to, o.pairs, hist.join(", "));
+            let hist: Vec<String> = o
+                .components_per_pair
+                .iter()
+                .map(|(k, n)| format!("{n} with {k}"))
+                .collect();
+            let _ = writeln!(
+                s,
+                "  {:>6} → {:<6} {:>5} pairs: {}",
+                o.from,
+                o.to,
+                o.pairs,
+                hist.join(", ")
+            );
         }
         self.check_text(&mut s);
         s
@@ -191,7 +226,11 @@ impl InfoReport {
 
     fn polygon_text(&self, s: &mut String, p: &PolygonReport) {
         let c = &p.constants;
-        let _ = writeln!(s, "\nFundamental polygon: {} sides, each corner angle ω", p.sides);
+        let _ = writeln!(
+            s,
+            "\nFundamental polygon: {} sides, each corner angle ω",
+            p.sides
+        );
         let _ = writeln!(s, "  ω = {:.15}  (2π/4n)", c.omega);
         if let (Some(h), Some(r)) = (c.h, c.r) {
             let _ = writeln!(s, "  h = {h:.15}  (distance to the edge circles' centres)");
@@ -199,27 +238,67 @@ impl InfoReport {
         }
         let _ = writeln!(s, "  γ = {:.15}  (distance to an edge midpoint)", c.gamma);
         let _ = writeln!(s, "  α = {:.15}  (distance to a corner)", c.alpha);
-        let _ = writeln!(s, "  β = ({:.15}, {:.15})  (where tessellation squares of edge charts 0 and 1 meet)", c.beta.re, c.beta.im);
-        let _ = writeln!(s, "  δ = {:.15}  (the paper's vertex-chart scale: boundary through β)", c.paper_delta);
-        let _ = writeln!(s, "  area = {:.12} by quadrature; Gauss–Bonnet wants {:.12}", p.area, p.expected_area);
+        let _ = writeln!(
+            s,
+            "  β = ({:.15}, {:.15})  (where tessellation squares of edge charts 0 and 1 meet)",
+            c.beta.re, c.beta.im
+        );
+        let _ = writeln!(
+            s,
+            "  δ = {:.15}  (the paper's vertex-chart scale: boundary through β)",
+            c.paper_delta
+        );
+        let _ = writeln!(
+            s,
+            "  area = {:.12} by quadrature; Gauss–Bonnet wants {:.12}",
+            p.area, p.expected_area
+        );
         let cycle: Vec<String> = p.vertex_cycle.iter().map(|c| c.to_string()).collect();
-        let _ = writeln!(s, "  corners around the vertex: {} → back to {}", cycle.join(" → "), p.vertex_cycle[0]);
+        let _ = writeln!(
+            s,
+            "  corners around the vertex: {} → back to {}",
+            cycle.join(" → "),
+            p.vertex_cycle[0]
+        );
     }
 
     fn check_text(&self, s: &mut String) {
         let c = &self.self_check;
         let k = &c.consistency;
-        let _ = writeln!(s, "\nSelf-check on {} points spread over the surface:", c.points);
-        let _ = writeln!(s, "  ψ_ii = id            largest error {:.2e}", k.identity_error);
-        let _ = writeln!(s, "  ψ_ji ∘ ψ_ij = id     largest error {:.2e}", k.inverse_error);
-        let _ = writeln!(s, "  ψ_jk ∘ ψ_ij = ψ_ik   largest error {:.2e}", k.cocycle_error);
+        let _ = writeln!(
+            s,
+            "\nSelf-check on {} points spread over the surface:",
+            c.points
+        );
+        let _ = writeln!(
+            s,
+            "  ψ_ii = id            largest error {:.2e}",
+            k.identity_error
+        );
+        let _ = writeln!(
+            s,
+            "  ψ_ji ∘ ψ_ij = id     largest error {:.2e}",
+            k.inverse_error
+        );
+        let _ = writeln!(
+            s,
+            "  ψ_jk ∘ ψ_ij = ψ_ik   largest error {:.2e}",
+            k.cocycle_error
+        );
         if k.missing > 0 {
-            let _ = writeln!(s, "  representations missed by some chart's view: {}", k.missing);
+            let _ = writeln!(
+                s,
+                "  representations missed by some chart's view: {}",
+                k.missing
+            );
         }
         let _ = writeln!(
             s,
             "  coverage margin      {:.5} chart units (worst at {:.6}{:+.6}i; up to {} charts hold a point)",
-            c.coverage.min_margin, c.coverage.worst_point.re, c.coverage.worst_point.im, c.coverage.max_charts
+            c.coverage.min_margin,
+            c.coverage.worst_point.re,
+            c.coverage.worst_point.im,
+            c.coverage.max_charts
         );
         let verdict = if c.passed { "passed" } else { "FAILED" };
         let _ = writeln!(s, "  {verdict} (errors ≤ {:.0e}, margin > 0)", c.tolerance);
@@ -229,7 +308,11 @@ impl InfoReport {
 fn scales_text(scales: &ChartScales) -> String {
     match scales {
         ChartScales::Sphere { cap } => format!("each cap covers |ζ| < {cap:.6} of its own side"),
-        ChartScales::Polygon { inside, edge, vertex } => format!(
+        ChartScales::Polygon {
+            inside,
+            edge,
+            vertex,
+        } => format!(
             "inside image radius {inside:.6}, edge square scale σ = {edge:.6}, vertex image radius {vertex:.6}"
         ),
     }

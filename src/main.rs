@@ -48,7 +48,13 @@ enum Command {
     #[command(verbatim_doc_comment)]
     Info {
         /// Genus of the surface: 0 (sphere), 1 (torus), 2 … 64.
-        #[arg(short, long, default_value_t = 2, value_name = "N", allow_negative_numbers = true)]
+        #[arg(
+            short,
+            long,
+            default_value_t = 2,
+            value_name = "N",
+            allow_negative_numbers = true
+        )]
         genus: u32,
         /// Print JSON instead of text.
         #[arg(long)]
@@ -98,7 +104,11 @@ fn init_logging(verbose: u8) {
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
-        Command::Info { genus, json, points } => {
+        Command::Info {
+            genus,
+            json,
+            points,
+        } => {
             tracing::info!(genus, points, "building the atlas");
             let report = ntori::info::report(genus, points as usize)
                 .with_context(|| format!("cannot build the charts for genus {genus}"))?;

@@ -170,7 +170,10 @@ impl ManifoldPoint {
     }
     /// The coordinates in `chart`, if the point lies in it.
     pub fn in_chart(&self, chart: ChartId) -> Option<Complex64> {
-        self.reps.iter().find(|p| p.chart == chart).map(|p| p.coords)
+        self.reps
+            .iter()
+            .find(|p| p.chart == chart)
+            .map(|p| p.coords)
     }
 }
 
@@ -261,10 +264,7 @@ impl Atlas {
         let chart = self.chart(p.chart)?;
         let w = p.coords;
         if !(w.re.is_finite() && w.im.is_finite()) {
-            return Err(ChartsError::NotFinite {
-                re: w.re,
-                im: w.im,
-            });
+            return Err(ChartsError::NotFinite { re: w.re, im: w.im });
         }
         let margin = chart.domain.margin(w);
         if margin <= 0.0 {

@@ -261,8 +261,9 @@ mod tests {
         for num in -17..40 {
             let z = unit_pi_fraction(num, 7);
             assert!(err(z.norm_sqr(), dd(1.0)) < 1e-31, "num {num}");
+            // The f64 reference itself is off by a few ulps of |θ| ≈ 7.
             let f = Complex64::from_polar(1.0, std::f64::consts::PI * num as f64 / 7.0);
-            assert!((z.to_f64() - f).norm() < 1e-15, "num {num}");
+            assert!((z.to_f64() - f).norm() < 1e-14, "num {num}");
         }
     }
 

@@ -70,7 +70,10 @@ impl Lft {
     /// # Panics
     /// If |p| ≥ 1 or p is not finite.
     pub fn translate(p: f64) -> Lft {
-        assert!(p.is_finite() && p.abs() < 1.0, "T(p) needs |p| < 1, got {p}");
+        assert!(
+            p.is_finite() && p.abs() < 1.0,
+            "T(p) needs |p| < 1, got {p}"
+        );
         ExactLft::hyperbolic_translation(dd(p)).to_lft()
     }
 
@@ -178,15 +181,38 @@ mod tests {
             let p = m.apply(Complex64::new(0.1, 0.05) + Complex64::from_polar(0.3, t));
             assert!(((p - c).norm() - r).abs() < 1e-14);
         }
-        assert!(Lft::new(Complex64::ZERO, Complex64::ONE, Complex64::ONE, Complex64::ZERO)
+        assert!(
+            Lft::new(
+                Complex64::ZERO,
+                Complex64::ONE,
+                Complex64::ONE,
+                Complex64::ZERO
+            )
             .unwrap()
             .image_of_disk(Complex64::ZERO, 0.5)
-            .is_none());
+            .is_none()
+        );
     }
 
     #[test]
     fn singular_matrices_are_refused() {
-        assert!(Lft::new(Complex64::ONE, Complex64::ONE, Complex64::ONE, Complex64::ONE).is_none());
-        assert!(Lft::new(Complex64::new(f64::NAN, 0.0), Complex64::ZERO, Complex64::ZERO, Complex64::ONE).is_none());
+        assert!(
+            Lft::new(
+                Complex64::ONE,
+                Complex64::ONE,
+                Complex64::ONE,
+                Complex64::ONE
+            )
+            .is_none()
+        );
+        assert!(
+            Lft::new(
+                Complex64::new(f64::NAN, 0.0),
+                Complex64::ZERO,
+                Complex64::ZERO,
+                Complex64::ONE
+            )
+            .is_none()
+        );
     }
 }

@@ -49,7 +49,9 @@ pub use scales::{ChartScales, DEFAULT_TABLE};
 /// What can go wrong when asking the charts layer for something.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ChartsError {
-    #[error("genus {genus} is not supported: the charts are built and validated for genus 0 to {max}")]
+    #[error(
+        "genus {genus} is not supported: the charts are built and validated for genus 0 to {max}"
+    )]
     UnsupportedGenus { genus: u32, max: u32 },
     #[error("there is no chart {index}: this atlas has charts 0 to {}", .count - 1)]
     NoSuchChart { index: u32, count: usize },

@@ -173,13 +173,9 @@ impl Polygon {
         let omega = std::f64::consts::TAU / sides as f64;
         let (alpha, gamma) = (to_f64(alpha_exact), to_f64(gamma_exact));
         let corners: Vec<Complex64> = (0..sides)
-            .map(|c| {
-                dd::unit_pi_fraction(2 * c as i64 + 1, sides as i64).to_f64() * alpha
-            })
+            .map(|c| dd::unit_pi_fraction(2 * c as i64 + 1, sides as i64).to_f64() * alpha)
             .collect();
-        let pairings: Vec<ExactLft> = (0..2 * n as i64)
-            .map(|j| pairing(j / 2, j % 2))
-            .collect();
+        let pairings: Vec<ExactLft> = (0..2 * n as i64).map(|j| pairing(j / 2, j % 2)).collect();
         let cross: Vec<ExactLft> = (0..sides)
             .map(|e| {
                 let (k, t) = (e / 4, e % 4);
@@ -274,7 +270,9 @@ impl Polygon {
         if naive {
             self.vertex_cycle
                 .iter()
-                .fold(crate::Lft::IDENTITY, |acc, s| acc.compose(&self.cross_f64[s.leave_by]))
+                .fold(crate::Lft::IDENTITY, |acc, s| {
+                    acc.compose(&self.cross_f64[s.leave_by])
+                })
         } else {
             dd::product(self.vertex_cycle.iter().map(|s| &self.cross[s.leave_by])).to_lft()
         }
@@ -291,7 +289,8 @@ impl Polygon {
     /// The frame at edge e: S(e^{ieω})·T(γ), taking 0 to the edge midpoint and the imaginary axis onto
     /// the edge (exact).
     pub(crate) fn edge_frame_exact(&self, e: usize) -> ExactLft {
-        ExactLft::rotation(e as i64, 2 * i64::from(self.genus)).then_after(&self.translation(self.gamma_exact))
+        ExactLft::rotation(e as i64, 2 * i64::from(self.genus))
+            .then_after(&self.translation(self.gamma_exact))
     }
 
     /// The frame at corner c: S(e^{i(c+½)ω})·T(α), taking 0 to the corner (exact).
@@ -313,7 +312,9 @@ impl Polygon {
     /// Hyperbolic: r − |z − centre|; Euclidean: signed distance past the edge line.
     pub fn outside_edge(&self, z: Complex64, e: usize) -> f64 {
         match self.geometry {
-            Geometry::Hyperbolic => self.constants.r.unwrap_or(0.0) - (z - self.edge_dirs[e]).norm(),
+            Geometry::Hyperbolic => {
+                self.constants.r.unwrap_or(0.0) - (z - self.edge_dirs[e]).norm()
+            }
             _ => (z * self.edge_dirs[e].conj()).re - 0.5,
         }
     }
@@ -348,7 +349,11 @@ impl Polygon {
                 .apply(self.corners[corner]);
             corner = self.nearest_corner(image);
             let arrived = self.partner(leave_by);
-            leave_by = if arrived == corner { (corner + 1) % s } else { corner };
+            leave_by = if arrived == corner {
+                (corner + 1) % s
+            } else {
+                corner
+            };
         }
         steps
     }

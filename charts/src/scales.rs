@@ -2,13 +2,26 @@
 //! the sizes are a design choice, made per genus to maximise the coverage margin: the smallest, over
 //! all surface points, of the largest distance to a chart boundary among the charts holding the point.
 //!
-//! The defaults for genus ≥ 2 come from `examples/tune_scales.rs`, which maximises the margin measured
-//! on 20 000 points spread over the polygon and prints the table below; `tests/coverage.rs` re-measures
-//! the margins on 10^5 other points. What they give (chart units; disk radius and square half-width are ½):
+//! The defaults for genus ≥ 2 come from `examples/tune_scales.rs`, a compass search that maximises the
+//! margin measured on 12 000 points spread over the polygon, and prints [`DEFAULT_TABLE`];
+//! `tests/coverage.rs` re-measures every genus on 10^5 points. Margins (chart units; disk radius and
+//! square half-width are ½), against the paper-like sizes (inside 0.95γ, σ = 7/8, vertex through β):
 //!
-//! | genus | margin  |   | genus | margin |
-//! |-------|---------|---|-------|--------|
-//! | see [`DEFAULT_TABLE`] and the test's output |
+//! | genus | tuned margin | paper-like |
+//! |-------|--------------|------------|
+//! | 0     | 0.166 (caps reach 22.5° past the equator) | — |
+//! | 1     | 0.124        | —          |
+//! | 2     | 0.142        | 0.100      |
+//! | 3     | 0.113        | 0.072      |
+//! | 5     | 0.083        | 0.050      |
+//! | 8     | 0.059        | 0.029      |
+//! | 16    | 0.036        | 0.006      |
+//! | 32    | 0.019        | gaps       |
+//! | 64    | 0.011        | gaps       |
+//!
+//! So: ≥ 0.02 up to genus 8 as required, and ≥ [`ChartScales::MARGIN_FLOOR`] = 0.01 up to genus 64.
+//! The inside disk ends up almost touching the edges (radius ≈ 0.998γ), the vertex disk reaches a bit
+//! past β, and σ stays near 0.98.
 //!
 //! Parameters, all in model-space units at the chart's own centre:
 //! - `inside`: Euclidean radius of the inside chart's image (a disk about 0 in the Poincaré disk);
@@ -30,10 +43,88 @@ pub enum ChartScales {
     Polygon { inside: f64, edge: f64, vertex: f64 },
 }
 
-/// Tuned defaults for genus 2..=64 as (genus, inside, edge, vertex), from `examples/tune_scales.rs`.
-pub const DEFAULT_TABLE: &[(u32, f64, f64, f64)] = &[];
+/// Tuned defaults for genus 2..=64 as (genus, inside, edge, vertex, margin), printed by
+/// `cargo run --release -p charts --example tune_scales`; `margin` is what the tuner measured.
+#[rustfmt::skip]
+pub const DEFAULT_TABLE: &[(u32, f64, f64, f64, f64)] = &[
+    (2, 0.641985, 0.910156, 0.641948, 0.14181),
+    (3, 0.756511, 0.962500, 0.759487, 0.11267),
+    (4, 0.805161, 0.979688, 0.809841, 0.09164),
+    (5, 0.852241, 0.981250, 0.848465, 0.08266),
+    (6, 0.875835, 0.990625, 0.871149, 0.07348),
+    (7, 0.890921, 0.993359, 0.885709, 0.06636),
+    (8, 0.905772, 0.987500, 0.891524, 0.05916),
+    (9, 0.915881, 0.994531, 0.911089, 0.05473),
+    (10, 0.924020, 0.996875, 0.922521, 0.05208),
+    (11, 0.930717, 0.996875, 0.926315, 0.04845),
+    (12, 0.936324, 0.987500, 0.934198, 0.04451),
+    (13, 0.941088, 0.987500, 0.940914, 0.04238),
+    (14, 0.945185, 0.996875, 0.943817, 0.04005),
+    (15, 0.948748, 0.987500, 0.928533, 0.03772),
+    (16, 0.951874, 0.987500, 0.932857, 0.03648),
+    (17, 0.954639, 0.988281, 0.936687, 0.03520),
+    (18, 0.957102, 0.978125, 0.940103, 0.03272),
+    (19, 0.959311, 0.975000, 0.943170, 0.03078),
+    (20, 0.961302, 0.999219, 0.945937, 0.03173),
+    (21, 0.963107, 0.975000, 0.948448, 0.02870),
+    (22, 0.964750, 0.994531, 0.950735, 0.02947),
+    (23, 0.966252, 0.975000, 0.952828, 0.02627),
+    (24, 0.967631, 0.993750, 0.954751, 0.02692),
+    (25, 0.968901, 0.975000, 0.956523, 0.02465),
+    (26, 0.970075, 0.975000, 0.958161, 0.02361),
+    (27, 0.971162, 0.978125, 0.959680, 0.02395),
+    (28, 0.972174, 0.995312, 0.961093, 0.02363),
+    (29, 0.973116, 0.993750, 0.962410, 0.02312),
+    (30, 0.973996, 0.994531, 0.963641, 0.02042),
+    (31, 0.974820, 0.975000, 0.964793, 0.02062),
+    (32, 0.975593, 0.987500, 0.965875, 0.02094),
+    (33, 0.976320, 0.990625, 0.969914, 0.02076),
+    (34, 0.977004, 0.993750, 0.973900, 0.02029),
+    (35, 0.977650, 0.993750, 0.971783, 0.01861),
+    (36, 0.978260, 0.999219, 0.972641, 0.01783),
+    (37, 0.978838, 0.975000, 0.976485, 0.01697),
+    (38, 0.979385, 0.975000, 0.977257, 0.01724),
+    (39, 0.979905, 0.975000, 0.978750, 0.01750),
+    (40, 0.980398, 0.978125, 0.978688, 0.01637),
+    (41, 0.980868, 0.981250, 0.980872, 0.01630),
+    (42, 0.981316, 0.996875, 0.973896, 0.01648),
+    (43, 0.981743, 0.987500, 0.974496, 0.01607),
+    (44, 0.982151, 0.996875, 0.975068, 0.01591),
+    (45, 0.982541, 0.987500, 0.975616, 0.01524),
+    (46, 0.982914, 0.990625, 0.976140, 0.01485),
+    (47, 0.983272, 0.993750, 0.976641, 0.01445),
+    (48, 0.983614, 0.975000, 0.977123, 0.01402),
+    (49, 0.983943, 0.975000, 0.977584, 0.01416),
+    (50, 0.984258, 0.981250, 0.978028, 0.01429),
+    (51, 0.984562, 0.993750, 0.978454, 0.01442),
+    (52, 0.984854, 0.989062, 0.978864, 0.01414),
+    (53, 0.985134, 0.987500, 0.979259, 0.01377),
+    (54, 0.985405, 0.996875, 0.979639, 0.01386),
+    (55, 0.985666, 0.975000, 0.980006, 0.01164),
+    (56, 0.985917, 0.987500, 0.980359, 0.01176),
+    (57, 0.986160, 0.975000, 0.980700, 0.01146),
+    (58, 0.986394, 0.987500, 0.981030, 0.01157),
+    (59, 0.986621, 0.975000, 0.981349, 0.01123),
+    (60, 0.986840, 0.987500, 0.981657, 0.01132),
+    (61, 0.987051, 0.993750, 0.981955, 0.01141),
+    (62, 0.987257, 0.975781, 0.982243, 0.01103),
+    (63, 0.987455, 0.987500, 0.982523, 0.01111),
+    (64, 0.987648, 0.975000, 0.982793, 0.01069),
+];
 
 impl ChartScales {
+    /// The coverage margin every default atlas keeps, genus 0 to 64 (chart units; re-measured on 10^5
+    /// points by `tests/coverage.rs`). Genus ≤ 8 keeps at least 0.02 (in fact ≥ 0.059).
+    pub const MARGIN_FLOOR: f64 = 0.01;
+
+    /// The margin the tuner measured for the default scales of `genus` (genus 2..=64).
+    pub fn tuned_margin(genus: u32) -> Option<f64> {
+        DEFAULT_TABLE
+            .iter()
+            .find(|row| row.0 == genus)
+            .map(|row| row.4)
+    }
+
     /// ntori's default sizes for `genus`.
     pub fn default_for(genus: u32) -> Result<ChartScales, ChartsError> {
         match genus {
@@ -50,7 +141,7 @@ impl ChartScales {
             n if n <= crate::MAX_GENUS => Ok(DEFAULT_TABLE
                 .iter()
                 .find(|row| row.0 == n)
-                .map(|&(_, inside, edge, vertex)| ChartScales::Polygon {
+                .map(|&(_, inside, edge, vertex, _)| ChartScales::Polygon {
                     inside,
                     edge,
                     vertex,
@@ -111,7 +202,9 @@ impl ChartScales {
                     ("vertex", vertex, limits.2),
                 ] {
                     if !(v.is_finite() && v > 0.0 && v < max) {
-                        return bad(format!("the {name} scale must lie in (0, {max:.4}), got {v}"));
+                        return bad(format!(
+                            "the {name} scale must lie in (0, {max:.4}), got {v}"
+                        ));
                     }
                 }
                 Ok(())

@@ -30,7 +30,10 @@ fn constants_agree_with_the_papers_equations_for_every_genus() {
         let w = c.omega;
         assert!((w - 2.0 * PI / (4.0 * n as f64)).abs() < 1e-15);
         // α = √cos(π/2n).
-        assert!((c.alpha - (PI / (2.0 * n as f64)).cos().sqrt()).abs() < 1e-14, "n = {n}");
+        assert!(
+            (c.alpha - (PI / (2.0 * n as f64)).cos().sqrt()).abs() < 1e-14,
+            "n = {n}"
+        );
         // Equation (3) for h, (2) for r, (5) for γ, (4) for α.
         let h3 = ((w.cos() + 1.0) / (w.cos() + 1.0 - 2.0 * (w / 2.0).sin().powi(2))).sqrt();
         let (h, r) = (c.h.unwrap(), c.r.unwrap());
@@ -38,7 +41,10 @@ fn constants_agree_with_the_papers_equations_for_every_genus() {
         assert!((r - (h * h - 1.0).sqrt()).abs() < 1e-7, "n = {n}"); // f64 cancellation in h² − 1
         assert!((c.gamma - (h - r)).abs() < 1e-14, "n = {n}");
         let hc = h * (w / 2.0).cos();
-        assert!((c.alpha - (hc - (hc * hc - 1.0).sqrt())).abs() < 1e-7, "n = {n}");
+        assert!(
+            (c.alpha - (hc - (hc * hc - 1.0).sqrt())).abs() < 1e-7,
+            "n = {n}"
+        );
     }
 }
 
@@ -49,7 +55,11 @@ fn corners_and_midpoints_lie_on_their_edges() {
         let c = *p.constants();
         for e in 0..p.sides() {
             let (c0, c1) = p.edge_corners(e);
-            for z in [p.corners()[c0], p.corners()[c1], Complex64::from_polar(c.gamma, e as f64 * c.omega)] {
+            for z in [
+                p.corners()[c0],
+                p.corners()[c1],
+                Complex64::from_polar(c.gamma, e as f64 * c.omega),
+            ] {
                 assert!(p.outside_edge(z, e).abs() < 1e-14, "n = {n}, e = {e}");
             }
         }
@@ -88,18 +98,30 @@ fn side_pairings_reverse_edges_and_map_corners_to_corners() {
             let (d0, d1) = p.edge_corners(dst);
             // Reversed orientation: the first corner of the source edge goes to the last of the target.
             let tol = 1e-11;
-            assert!((g.apply(p.corners()[s0]) - p.corners()[d1]).norm() < tol, "n {n} j {j}");
-            assert!((g.apply(p.corners()[s1]) - p.corners()[d0]).norm() < tol, "n {n} j {j}");
+            assert!(
+                (g.apply(p.corners()[s0]) - p.corners()[d1]).norm() < tol,
+                "n {n} j {j}"
+            );
+            assert!(
+                (g.apply(p.corners()[s1]) - p.corners()[d0]).norm() < tol,
+                "n {n} j {j}"
+            );
             let mid = |e: usize| Complex64::from_polar(c.gamma, e as f64 * c.omega);
             assert!((g.apply(mid(src)) - mid(dst)).norm() < 1e-13, "n {n} j {j}");
             // Points along the source edge land on the target edge; the polygon's inside goes outside.
             for s in [0.1, 0.35, 0.8] {
                 let z = point_on_edge(&p, src, s);
                 assert!(p.outside_edge(z, src).abs() < 1e-13);
-                assert!(p.outside_edge(g.apply(z), dst).abs() < 1e-11, "n {n} j {j} s {s}");
+                assert!(
+                    p.outside_edge(g.apply(z), dst).abs() < 1e-11,
+                    "n {n} j {j} s {s}"
+                );
             }
             let inside_near_src = mid(src) * 0.98;
-            assert!(p.outside_edge(g.apply(inside_near_src), dst) > 0.0, "n {n} j {j}");
+            assert!(
+                p.outside_edge(g.apply(inside_near_src), dst) > 0.0,
+                "n {n} j {j}"
+            );
             // Fixes no point of the open disk: |trace| ≥ 2 (hyperbolic or parabolic in SL2).
             let [a, _, _, d] = g.matrix();
             assert!((a + d).norm() > 2.0 - 1e-9, "n {n} j {j}");
@@ -132,7 +154,10 @@ fn naive_f64_products_lose_what_double_double_keeps() {
     let p = Polygon::new(64).unwrap();
     let naive = p.vertex_composite(true).distance(&Lft::IDENTITY);
     let exact = p.vertex_composite(false).distance(&Lft::IDENTITY);
-    assert!(naive > 1e3 * exact.max(1e-16), "naive {naive:e}, exact {exact:e}");
+    assert!(
+        naive > 1e3 * exact.max(1e-16),
+        "naive {naive:e}, exact {exact:e}"
+    );
 }
 
 #[test]
@@ -140,7 +165,10 @@ fn area_is_4pi_times_genus_minus_one() {
     for n in hyperbolic_genera() {
         let area = Polygon::new(n).unwrap().area_by_quadrature();
         let want = 4.0 * PI * (n as f64 - 1.0);
-        assert!(((area - want) / want).abs() < 1e-9, "n = {n}: {area} vs {want}");
+        assert!(
+            ((area - want) / want).abs() < 1e-9,
+            "n = {n}: {area} vs {want}"
+        );
     }
 }
 
