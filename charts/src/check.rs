@@ -210,7 +210,12 @@ fn descend(
     // failure, and the step halves only after two failures in a row.
     let mut turn = 0.0_f64;
     let (mut step, mut failures) = (start, 0);
-    while step > 1e-10 {
+    // Creeping along a crease can take many small successful steps; 400 rounds reach 1e-10 steps
+    // from any start used here and bound the cost.
+    for _ in 0..400 {
+        if step <= 1e-10 {
+            break;
+        }
         let here = step * metric(z);
         let best = (0..16)
             .map(|k| z + Complex64::from_polar(here, turn + k as f64 * std::f64::consts::PI / 8.0))

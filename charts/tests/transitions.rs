@@ -277,3 +277,84 @@ fn chart_scales_are_validated() {
         );
     }
 }
+
+/// Number of 8-connected pieces of the grid cells whose centres lie in the component.
+fn pieces(atlas: &Atlas, t: &charts::Transition, m: usize) -> usize {
+    let (from, to) = (
+        atlas.charts()[t.from.index()].domain(),
+        atlas.charts()[t.to.index()].domain(),
+    );
+    let at = |x: usize, y: usize| {
+        Complex64::new(
+            (x as f64 + 0.5) / m as f64 - 0.5,
+            (y as f64 + 0.5) / m as f64 - 0.5,
+        )
+    };
+    let mut inside: Vec<bool> = (0..m * m)
+        .map(|k| {
+            let w = at(k % m, k / m);
+            from.contains(w) && to.contains(t.apply(w))
+        })
+        .collect();
+    let mut count = 0;
+    for start in 0..m * m {
+        if !inside[start] {
+            continue;
+        }
+        count += 1;
+        let mut stack = vec![start];
+        inside[start] = false;
+        while let Some(k) = stack.pop() {
+            let (x, y) = ((k % m) as isize, (k / m) as isize);
+            for (dx, dy) in [
+                (-1, -1),
+                (-1, 0),
+                (-1, 1),
+                (0, -1),
+                (0, 1),
+                (1, -1),
+                (1, 0),
+                (1, 1),
+            ] {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx >= 0 && ny >= 0 && (nx as usize) < m && (ny as usize) < m {
+                    let nk = ny as usize * m + nx as usize;
+                    if inside[nk] {
+                        inside[nk] = false;
+                        stack.push(nk);
+                    }
+                }
+            }
+        }
+    }
+    count
+}
+
+#[test]
+fn each_overlap_component_is_connected_and_non_empty() {
+    for genus in [0, 1, 2, 3, 5] {
+        let atlas = atlas(genus);
+        for a in atlas.charts() {
+            for b in atlas.charts().iter().filter(|b| b.id() != a.id()) {
+                for t in atlas.transitions(a.id(), b.id()) {
+                    let k = pieces(atlas, t, 400);
+                    // A sliver thinner than the grid may show no cell; it must never show two pieces.
+                    assert!(
+                        k <= 1,
+                        "genus {genus}: U_{}{} component splits into {k} pieces",
+                        a.id().0,
+                        b.id().0
+                    );
+                    if k == 0 {
+                        assert!(
+                            pieces(atlas, t, 2000) == 1,
+                            "genus {genus}: empty or split component in U_{}{}",
+                            a.id().0,
+                            b.id().0
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
