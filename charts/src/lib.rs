@@ -39,12 +39,14 @@ mod overlap;
 mod points;
 mod polygon;
 mod scales;
+mod tessellation;
 
 pub use atlas::{Atlas, Chart, ChartKind, Domain, MAX_GENUS, ManifoldPoint, Transition};
 pub use lft::Lft;
 pub use points::{ChartId, ChartPoint, DiskPoint, ModelPoint};
 pub use polygon::{Geometry, Polygon, PolygonConstants, VertexStep};
 pub use scales::{ChartScales, DEFAULT_TABLE};
+pub use tessellation::{MAX_RESOLUTION, MAX_TRIANGLES, Region, Tessellation};
 
 /// What can go wrong when asking the charts layer for something.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -66,4 +68,6 @@ pub enum ChartsError {
     },
     #[error("invalid chart scales: {0}")]
     InvalidScales(String),
+    #[error("cannot tessellate: {0}")]
+    InvalidTessellation(String),
 }

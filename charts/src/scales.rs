@@ -24,7 +24,10 @@
 //! So: ≥ 0.02 up to genus 8 as required (in fact ≥ 0.05), and ≥ [`ChartScales::MARGIN_FLOOR`] = 0.006
 //! up to genus 64 (smallest estimate 0.0070, at genus 64; the floor leaves room for minima the search
 //! may not reach). The inside disk ends up almost touching the edges (radius ≈ 0.998γ), the vertex
-//! disk reaches a little past β, and σ stays near 0.98. The tuner's objective was sampled only;
+//! disk reaches a little past β, and σ stays near 0.98. `default_for` then grows the vertex disk where
+//! needed so that it holds the tessellation's vertex wheel (module `tessellation`), up to just below
+//! its injectivity limit (hyperbolic radius half the edge length); growing a chart can only raise the
+//! margins above. The tuner's objective was sampled only;
 //! re-tuning against the refined margin would raise the high-genus figures somewhat.
 //!
 //! Parameters, all in model-space units at the chart's own centre:
@@ -138,20 +141,24 @@ impl ChartScales {
                 cap: (5.0 * std::f64::consts::PI / 16.0).tan(),
             }),
             // The flat torus: the unit square with corners at distance √½ from its centre.
+            // The vertex disk (radius 0.4) holds the tessellation's vertex wheel, which reaches √2/4.
             1 => Ok(ChartScales::Polygon {
                 inside: 0.45,
                 edge: 0.9,
-                vertex: 0.3,
+                vertex: 0.4,
             }),
-            n if n <= crate::MAX_GENUS => Ok(DEFAULT_TABLE
-                .iter()
-                .find(|row| row.0 == n)
-                .map(|&(_, inside, edge, vertex, _)| ChartScales::Polygon {
-                    inside,
-                    edge,
-                    vertex,
-                })
-                .unwrap_or_else(|| Self::heuristic(n))),
+            n if n <= crate::MAX_GENUS => {
+                let tuned = DEFAULT_TABLE
+                    .iter()
+                    .find(|row| row.0 == n)
+                    .map(|&(_, inside, edge, vertex, _)| ChartScales::Polygon {
+                        inside,
+                        edge,
+                        vertex,
+                    })
+                    .unwrap_or_else(|| Self::heuristic(n));
+                Ok(tuned.holding_the_vertex_wheel(&crate::Polygon::hyperbolic(n)))
+            }
             genus => Err(ChartsError::UnsupportedGenus {
                 genus,
                 max: crate::MAX_GENUS,
@@ -168,6 +175,42 @@ impl ChartScales {
             inside: 0.95 * c.gamma,
             edge: 0.875,
             vertex: 0.5 * c.paper_delta,
+        }
+    }
+
+    /// The tessellation's vertex wheel (bounded by the edge squares' sides b = ±s) must lie inside the
+    /// vertex chart; the coverage tuning alone leaves its boundary right at the chart's edge. Growing a
+    /// chart only raises coverage margins, so grow the vertex disk until the wheel reaches |w| ≤ 0.45.
+    fn holding_the_vertex_wheel(self, poly: &crate::Polygon) -> ChartScales {
+        let ChartScales::Polygon {
+            inside,
+            edge,
+            vertex,
+        } = self
+        else {
+            return self;
+        };
+        let frame = poly.edge_frame_exact(0).to_lft();
+        let to_corner = poly.corner_frame_exact(0).to_lft().inverse();
+        let w_beta = frame.inverse().apply(poly.constants().beta) / edge;
+        let s = 0.5 * (w_beta.im - w_beta.re);
+        // The side b = +s of edge chart a₁ is the wheel's arc about corner 0 (all arcs are congruent).
+        let reach = (0..=64)
+            .map(|k| {
+                let a = -s + 2.0 * s * f64::from(k) / 64.0;
+                let z = frame.apply(num_complex::Complex64::new(a, s) * edge);
+                to_corner.apply(z).norm()
+            })
+            .fold(0.0, f64::max);
+        // The disk must stay injective: its hyperbolic radius below half the edge length L (the
+        // nearest other lifts of the vertex are the adjacent corners), i.e. below tanh(L/4).
+        let (c0, c1) = (poly.corners()[0], poly.corners()[1]);
+        let d = (c0 - c1).norm() / (num_complex::Complex64::ONE - c0.conj() * c1).norm();
+        let limit = d / (1.0 + (1.0 - d * d).sqrt());
+        ChartScales::Polygon {
+            inside,
+            edge,
+            vertex: vertex.max((reach / 0.9).min(0.995 * limit)),
         }
     }
 

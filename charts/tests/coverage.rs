@@ -27,11 +27,12 @@ fn check_genera(genera: impl IntoIterator<Item = u32>) {
             "genus {genus}: margin {} < {floor}",
             c.min_margin
         );
-        // The tuner measured on fewer points; more points may find slightly worse spots, not much worse.
-        if let Some(tuned) = ChartScales::documented_margin(genus) {
+        // The documented figure is a lower estimate (10^5 and 10^6 starts, before the vertex chart
+        // was grown to hold the tessellation's vertex wheel, which only raises margins).
+        if let Some(documented) = ChartScales::documented_margin(genus) {
             assert!(
-                c.min_margin >= 0.95 * tuned,
-                "genus {genus}: {} vs tuned {tuned}",
+                c.min_margin >= 0.95 * documented,
+                "genus {genus}: {} vs documented {documented}",
                 c.min_margin
             );
         }

@@ -1,0 +1,285 @@
+//! The paper's t_e/t_r tessellation of the surface (section 5.2, figure 7).
+//!
+//! Coarsest level (genus n ≥ 1): a square [−s, s]² in each edge chart, s chosen so that the corners of
+//! neighbouring squares meet at the point β (and its images about the 4n corners); what the squares
+//! leave is two "wheels", one about the inside chart's centre and one about the vertex, each bounded by
+//! 4n arcs (square sides a = ±s face the inside wheel, b = ±s the vertex wheel). Then t_e divides each
+//! square into a t_e × t_e grid and each arc into t_e pieces; t_r divides each wheel's spokes. Genus 0
+//! has no squares: two wheels (the caps) meet along the equator, divided into 4·t_e arcs.
+//!
+//! Counts, with n the genus, e = t_e, r = t_r (tested):
+//! - genus ≥ 1: V = 2n(e² + 2e − 1) + 2 + 8n·e(r − 1), F = 4n·e² + 8n·e(2r − 1), E = 3F/2;
+//! - genus 0:   V = 4e + 2 + 8e(r − 1),                F = 8e(2r − 1),              E = 3F/2;
+//!
+//! so V − E + F = 2 − 2n. Every vertex is a chart point in its home chart (squares' vertices in their
+//! edge chart, ring vertices in their wheel's chart), and is shared, never duplicated, between regions.
+
+use num_complex::Complex64;
+use serde::Serialize;
+
+use crate::{Atlas, ChartId, ChartKind, ChartPoint, ChartsError, Domain};
+
+/// The largest t_e or t_r accepted, and the largest triangle count.
+pub const MAX_RESOLUTION: u32 = 4096;
+pub const MAX_TRIANGLES: u64 = 50_000_000;
+
+/// Which region of the coarsest tessellation a triangle belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Region {
+    /// The square of an edge chart.
+    Square,
+    /// The wheel about the inside chart's centre (or a sphere cap).
+    InsideWheel,
+    /// The wheel about the surface's vertex.
+    VertexWheel,
+}
+
+/// A triangle mesh of the surface whose vertices are manifold points.
+#[derive(Clone, Debug)]
+pub struct Tessellation {
+    pub te: u32,
+    pub tr: u32,
+    /// Each vertex in its home chart.
+    pub vertices: Vec<ChartPoint>,
+    /// Vertex indices, counter-clockwise in the triangle's home chart.
+    pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's home chart (the chart of its region) and region.
+    pub triangle_charts: Vec<ChartId>,
+    pub triangle_regions: Vec<Region>,
+    /// Each triangle's corners in its home chart's coordinates.
+    pub triangle_coords: Vec<[Complex64; 3]>,
+}
+
+impl Tessellation {
+    /// The vertex count the module's formula predicts.
+    pub fn expected_vertices(genus: u32, te: u32, tr: u32) -> u64 {
+        let (n, e, r) = (u64::from(genus), u64::from(te), u64::from(tr));
+        if genus == 0 {
+            4 * e + 2 + 8 * e * (r - 1)
+        } else {
+            2 * n * (e * e + 2 * e - 1) + 2 + 8 * n * e * (r - 1)
+        }
+    }
+
+    /// The triangle count the module's formula predicts.
+    pub fn expected_triangles(genus: u32, te: u32, tr: u32) -> u64 {
+        let (n, e, r) = (u64::from(genus), u64::from(te), u64::from(tr));
+        if genus == 0 {
+            8 * e * (2 * r - 1)
+        } else {
+            4 * n * e * e + 8 * n * e * (2 * r - 1)
+        }
+    }
+}
+
+/// Accumulates vertices and triangles.
+struct Builder<'a> {
+    atlas: &'a Atlas,
+    t: Tessellation,
+}
+
+impl Builder<'_> {
+    fn vertex(&mut self, p: ChartPoint) -> u32 {
+        self.t.vertices.push(p);
+        (self.t.vertices.len() - 1) as u32
+    }
+
+    fn triangle(&mut self, chart: ChartId, region: Region, ids: [u32; 3], coords: [Complex64; 3]) {
+        self.t.triangles.push(ids);
+        self.t.triangle_charts.push(chart);
+        self.t.triangle_regions.push(region);
+        self.t.triangle_coords.push(coords);
+    }
+
+    /// Coordinates of a vertex in `chart`, or an error naming the region that does not fit.
+    fn coords_in(&self, id: u32, chart: ChartId, what: &str) -> Result<Complex64, ChartsError> {
+        let p = self.t.vertices[id as usize];
+        if p.chart == chart {
+            return Ok(p.coords);
+        }
+        self.atlas
+            .locate_unchecked(p)
+            .in_chart(chart)
+            .ok_or_else(|| {
+                ChartsError::InvalidTessellation(format!(
+                    "the {what} does not fit inside {}: chart sizes too small for this layout",
+                    self.atlas.charts()[chart.index()].kind().label()
+                ))
+            })
+    }
+
+    /// A wheel about the centre of `chart`: boundary vertices (any order), sorted by angle in the
+    /// wheel's chart, joined to the centre by spokes divided into t_r pieces.
+    fn wheel(&mut self, chart: ChartId, region: Region, boundary: &[u32], what: &str) -> Result<(), ChartsError> {
+        let mut ring: Vec<(u32, Complex64)> = boundary
+            .iter()
+            .map(|&id| Ok((id, self.coords_in(id, chart, what)?)))
+            .collect::<Result<_, ChartsError>>()?;
+        ring.sort_by(|a, b| a.1.arg().total_cmp(&b.1.arg()));
+        let tr = self.t.tr;
+        let centre = self.vertex(ChartPoint::new(chart, Complex64::ZERO));
+        let mut inner: Vec<(u32, Complex64)> = Vec::new();
+        for r in 1..=tr {
+            let outer: Vec<(u32, Complex64)> = if r == tr {
+                ring.clone()
+            } else {
+                let f = f64::from(r) / f64::from(tr);
+                ring.iter()
+                    .map(|&(_, w)| (self.vertex(ChartPoint::new(chart, w * f)), w * f))
+                    .collect()
+            };
+            let m = outer.len();
+            for k in 0..m {
+                let (a, b) = (outer[k], outer[(k + 1) % m]);
+                if r == 1 {
+                    self.triangle(chart, region, [centre, a.0, b.0], [Complex64::ZERO, a.1, b.1]);
+                } else {
+                    let (c, d) = (inner[k], inner[(k + 1) % m]);
+                    self.triangle(chart, region, [c.0, a.0, b.0], [c.1, a.1, b.1]);
+                    self.triangle(chart, region, [c.0, b.0, d.0], [c.1, b.1, d.1]);
+                }
+            }
+            inner = outer;
+        }
+        Ok(())
+    }
+}
+
+impl Atlas {
+    /// The t_e/t_r tessellation (see the module documentation).
+    ///
+    /// ```
+    /// let atlas = charts::Atlas::new(2).unwrap();
+    /// let t = atlas.tessellate(2, 3).unwrap();
+    /// let (v, f) = (t.vertices.len() as i64, t.triangles.len() as i64);
+    /// assert_eq!(v - 3 * f / 2 + f, -2); // χ = 2 − 2n
+    /// ```
+    pub fn tessellate(&self, te: u32, tr: u32) -> Result<Tessellation, ChartsError> {
+        for (name, v) in [("t_e", te), ("t_r", tr)] {
+            if v == 0 || v > MAX_RESOLUTION {
+                return Err(ChartsError::InvalidTessellation(format!(
+                    "{name} must lie in 1..={MAX_RESOLUTION}, got {v}"
+                )));
+            }
+        }
+        let triangles = Tessellation::expected_triangles(self.genus(), te, tr);
+        if triangles > MAX_TRIANGLES {
+            return Err(ChartsError::InvalidTessellation(format!(
+                "t_e = {te}, t_r = {tr} would make {triangles} triangles (limit {MAX_TRIANGLES})"
+            )));
+        }
+        let mut b = Builder {
+            atlas: self,
+            t: Tessellation {
+                te,
+                tr,
+                vertices: Vec::new(),
+                triangles: Vec::with_capacity(triangles as usize),
+                triangle_charts: Vec::new(),
+                triangle_regions: Vec::new(),
+                triangle_coords: Vec::new(),
+            },
+        };
+        if self.polygon().is_some() {
+            self.tessellate_polygon(&mut b)?;
+        } else {
+            self.tessellate_sphere(&mut b)?;
+        }
+        Ok(b.t)
+    }
+
+    /// Half-size s of the tessellation squares: β = φ(−s + i s) in edge chart a₁.
+    pub fn tessellation_square_half(&self) -> Option<f64> {
+        let beta = self.polygon()?.constants().beta;
+        let chart = self.charts().iter().find(|c| c.domain() == Domain::Square)?;
+        let w = chart.to_model().inverse().apply(beta);
+        Some(0.5 * (w.im - w.re))
+    }
+
+    fn tessellate_sphere(&self, b: &mut Builder) -> Result<(), ChartsError> {
+        let (north, south) = (ChartId(0), ChartId(1));
+        let arcs = 4 * b.t.te;
+        let to_north = self.charts()[0].to_model().inverse();
+        let equator: Vec<u32> = (0..arcs)
+            .map(|k| {
+                let z = Complex64::from_polar(1.0, std::f64::consts::TAU * f64::from(k) / f64::from(arcs));
+                b.vertex(ChartPoint::new(north, to_north.apply(z)))
+            })
+            .collect();
+        b.wheel(north, Region::InsideWheel, &equator, "northern cap")?;
+        b.wheel(south, Region::InsideWheel, &equator, "southern cap")
+    }
+
+    fn tessellate_polygon(&self, b: &mut Builder) -> Result<(), ChartsError> {
+        let poly = self.polygon().expect("polygon atlas");
+        let s = self.tessellation_square_half().expect("polygon atlas");
+        if !(s > 0.0 && s < 0.5) {
+            return Err(ChartsError::InvalidTessellation(format!(
+                "the tessellation square (half-size {s}) does not fit in its edge chart"
+            )));
+        }
+        let te = b.t.te as usize;
+        let c = *poly.constants();
+        let betas: Vec<Complex64> = (0..poly.sides())
+            .map(|k| c.beta * Complex64::from_polar(1.0, k as f64 * c.omega))
+            .collect();
+        let mut corner_ids: Vec<Option<u32>> = vec![None; poly.sides()];
+        let (mut inside_ring, mut vertex_ring) = (Vec::new(), Vec::new());
+        let squares: Vec<ChartId> = self
+            .charts()
+            .iter()
+            .filter(|ch| matches!(ch.kind(), ChartKind::Edge { .. }))
+            .map(|ch| ch.id())
+            .collect();
+        for &chart in &squares {
+            let at = |i: usize, k: usize| {
+                Complex64::new(-s + 2.0 * s * i as f64 / te as f64, -s + 2.0 * s * k as f64 / te as f64)
+            };
+            let mut grid = vec![0u32; (te + 1) * (te + 1)];
+            for k in 0..=te {
+                for i in 0..=te {
+                    let w = at(i, k);
+                    let corner = (i == 0 || i == te) && (k == 0 || k == te);
+                    let id = if corner {
+                        // Which β this corner is: reduce its image into the polygon, take the nearest.
+                        let z = poly.reduce(self.charts()[chart.index()].to_model().apply(w));
+                        let which = (0..betas.len())
+                            .min_by(|&x, &y| (betas[x] - z).norm().total_cmp(&(betas[y] - z).norm()))
+                            .unwrap_or(0);
+                        *corner_ids[which].get_or_insert_with(|| b.vertex(ChartPoint::new(chart, w)))
+                    } else {
+                        b.vertex(ChartPoint::new(chart, w))
+                    };
+                    grid[k * (te + 1) + i] = id;
+                    // Sides a = ±s face the inside wheel, b = ±s the vertex wheel (corners: both).
+                    if i == 0 || i == te {
+                        inside_ring.push(id);
+                    }
+                    if k == 0 || k == te {
+                        vertex_ring.push(id);
+                    }
+                }
+            }
+            for k in 0..te {
+                for i in 0..te {
+                    let g = |i: usize, k: usize| (grid[k * (te + 1) + i], at(i, k));
+                    let (p00, p10, p11, p01) = (g(i, k), g(i + 1, k), g(i + 1, k + 1), g(i, k + 1));
+                    b.triangle(chart, Region::Square, [p00.0, p10.0, p11.0], [p00.1, p10.1, p11.1]);
+                    b.triangle(chart, Region::Square, [p00.0, p11.0, p01.0], [p00.1, p11.1, p01.1]);
+                }
+            }
+        }
+        for ring in [&mut inside_ring, &mut vertex_ring] {
+            ring.sort_unstable();
+            ring.dedup();
+        }
+        let inside = self.charts().iter().find(|ch| ch.kind() == ChartKind::Inside).map(|ch| ch.id());
+        let vertex = self.charts().iter().find(|ch| ch.kind() == ChartKind::Vertex).map(|ch| ch.id());
+        let (Some(inside), Some(vertex)) = (inside, vertex) else {
+            unreachable!("polygon atlases have an inside and a vertex chart")
+        };
+        b.wheel(inside, Region::InsideWheel, &inside_ring, "inside wheel")?;
+        b.wheel(vertex, Region::VertexWheel, &vertex_ring, "vertex wheel")
+    }
+}
