@@ -4,6 +4,7 @@
 //! renderer and the editor) over the [`charts`] and [`embedding`] crates.
 
 pub mod info;
+pub mod mesh;
 
 pub use charts;
 pub use embedding;

@@ -113,10 +113,17 @@ pub struct Chart {
     /// origin for hyperbolic charts, after moving the centre to 0).
     centre: Complex64,
     ball: f64,
+    scale: f64,
     tiles: Vec<Tile>,
 }
 
 impl Chart {
+    /// φ = F ∘ (w ↦ scale·w) with F an isometry of the model space (a rotation and translation, or
+    /// for the southern cap the sphere's half-turn ζ ↦ 1/ζ). So distances, angles and areas of a figure
+    /// in this chart can be measured on `scale·w` near the origin, where the model is well conditioned.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
     pub fn id(&self) -> ChartId {
         self.id
     }
@@ -354,6 +361,7 @@ impl Atlas {
                 to_model: exact.to_lft(),
                 centre: exact.to_lft().apply(Complex64::ZERO),
                 ball: 0.5,
+                scale: 2.0 * cap,
                 tiles: vec![Tile {
                     group: ExactLft::identity(),
                     from_polygon: exact.inverse().to_lft(),
@@ -403,7 +411,9 @@ impl Atlas {
         };
         let n = poly.genus();
         let mut charts = Vec::with_capacity(2 * n as usize + 2);
-        let mut push = |kind, domain: Domain, exact: ExactLft, ball: f64| {
+        // Each chart is an isometric frame after a scaling of its domain.
+        let mut push = |kind, domain: Domain, frame: ExactLft, scale: f64| {
+            let exact = frame.then_after(&ExactLft::scaling(dd(scale)));
             let to_model = exact.to_lft();
             charts.push(Chart {
                 id: ChartId(charts.len() as u32),
@@ -412,7 +422,8 @@ impl Atlas {
                 exact,
                 to_model,
                 centre: to_model.apply(Complex64::ZERO),
-                ball,
+                ball: scale * domain.circumradius(),
+                scale,
                 tiles: Vec::new(),
             });
         };
@@ -420,15 +431,14 @@ impl Atlas {
         push(
             ChartKind::Inside,
             Domain::Disk,
-            ExactLft::scaling(dd(2.0 * inside)),
-            inside,
+            ExactLft::identity(),
+            2.0 * inside,
         );
         push(
             ChartKind::Vertex,
             Domain::Disk,
-            poly.corner_frame_exact(0)
-                .then_after(&ExactLft::scaling(dd(2.0 * vertex))),
-            vertex,
+            poly.corner_frame_exact(0),
+            2.0 * vertex,
         );
         for j in 0..2 * n {
             let (handle, side) = (j / 2, j % 2);
@@ -436,8 +446,8 @@ impl Atlas {
             push(
                 ChartKind::Edge { handle, side },
                 Domain::Square,
-                frame.then_after(&ExactLft::scaling(dd(edge))),
-                edge * Domain::Square.circumradius(),
+                frame,
+                edge,
             );
         }
         for chart in &mut charts {

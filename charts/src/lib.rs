@@ -46,7 +46,10 @@ pub use lft::Lft;
 pub use points::{ChartId, ChartPoint, DiskPoint, ModelPoint};
 pub use polygon::{Geometry, Polygon, PolygonConstants, VertexStep};
 pub use scales::{ChartScales, DEFAULT_TABLE};
-pub use tessellation::{MAX_RESOLUTION, MAX_TRIANGLES, Region, Tessellation};
+pub use tessellation::{
+    EDGE_INNER, EDGE_INSIDE_ARC, EDGE_VERTEX_ARC, MAX_RESOLUTION, MAX_TRIANGLES, Region,
+    Tessellation,
+};
 
 /// What can go wrong when asking the charts layer for something.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

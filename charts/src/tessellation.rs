@@ -49,7 +49,18 @@ pub struct Tessellation {
     pub triangle_regions: Vec<Region>,
     /// Each triangle's corners in its home chart's coordinates.
     pub triangle_coords: Vec<[Complex64; 3]>,
+    /// Per triangle side (side i runs from corner i to corner i + 1): [`EDGE_INNER`], or which arc of
+    /// the coarsest level it lies on. At t_e = 1 two different arcs can join the same two vertices
+    /// (squares a_k and b_k share three corners), so an edge is its endpoints *and* this label.
+    pub triangle_edge_labels: Vec<[u32; 3]>,
 }
+
+/// A triangle side inside a region.
+pub const EDGE_INNER: u32 = 0;
+/// A side on an arc between a square (or the other cap) and the inside wheel.
+pub const EDGE_INSIDE_ARC: u32 = 1;
+/// A side on an arc between a square and the vertex wheel.
+pub const EDGE_VERTEX_ARC: u32 = 2;
 
 impl Tessellation {
     /// The vertex count the module's formula predicts.
@@ -85,8 +96,16 @@ impl Builder<'_> {
         (self.t.vertices.len() - 1) as u32
     }
 
-    fn triangle(&mut self, chart: ChartId, region: Region, ids: [u32; 3], coords: [Complex64; 3]) {
+    fn triangle(
+        &mut self,
+        chart: ChartId,
+        region: Region,
+        ids: [u32; 3],
+        coords: [Complex64; 3],
+        labels: [u32; 3],
+    ) {
         self.t.triangles.push(ids);
+        self.t.triangle_edge_labels.push(labels);
         self.t.triangle_charts.push(chart);
         self.t.triangle_regions.push(region);
         self.t.triangle_coords.push(coords);
@@ -111,7 +130,18 @@ impl Builder<'_> {
 
     /// A wheel about the centre of `chart`: boundary vertices (any order), sorted by angle in the
     /// wheel's chart, joined to the centre by spokes divided into t_r pieces.
-    fn wheel(&mut self, chart: ChartId, region: Region, boundary: &[u32], what: &str) -> Result<(), ChartsError> {
+    fn wheel(
+        &mut self,
+        chart: ChartId,
+        region: Region,
+        boundary: &[u32],
+        what: &str,
+    ) -> Result<(), ChartsError> {
+        let arc = if region == Region::VertexWheel {
+            EDGE_VERTEX_ARC
+        } else {
+            EDGE_INSIDE_ARC
+        };
         let mut ring: Vec<(u32, Complex64)> = boundary
             .iter()
             .map(|&id| Ok((id, self.coords_in(id, chart, what)?)))
@@ -130,14 +160,36 @@ impl Builder<'_> {
                     .collect()
             };
             let m = outer.len();
+            // The outermost ring's sides lie on the wheel's boundary arcs.
+            let rim = if r == tr { arc } else { EDGE_INNER };
             for k in 0..m {
                 let (a, b) = (outer[k], outer[(k + 1) % m]);
                 if r == 1 {
-                    self.triangle(chart, region, [centre, a.0, b.0], [Complex64::ZERO, a.1, b.1]);
+                    let ids = [centre, a.0, b.0];
+                    self.triangle(
+                        chart,
+                        region,
+                        ids,
+                        [Complex64::ZERO, a.1, b.1],
+                        [EDGE_INNER, rim, EDGE_INNER],
+                    );
                 } else {
                     let (c, d) = (inner[k], inner[(k + 1) % m]);
-                    self.triangle(chart, region, [c.0, a.0, b.0], [c.1, a.1, b.1]);
-                    self.triangle(chart, region, [c.0, b.0, d.0], [c.1, b.1, d.1]);
+                    let inner_labels = [EDGE_INNER, rim, EDGE_INNER];
+                    self.triangle(
+                        chart,
+                        region,
+                        [c.0, a.0, b.0],
+                        [c.1, a.1, b.1],
+                        inner_labels,
+                    );
+                    self.triangle(
+                        chart,
+                        region,
+                        [c.0, b.0, d.0],
+                        [c.1, b.1, d.1],
+                        [EDGE_INNER; 3],
+                    );
                 }
             }
             inner = outer;
@@ -179,6 +231,7 @@ impl Atlas {
                 triangle_charts: Vec::new(),
                 triangle_regions: Vec::new(),
                 triangle_coords: Vec::new(),
+                triangle_edge_labels: Vec::new(),
             },
         };
         if self.polygon().is_some() {
@@ -192,7 +245,10 @@ impl Atlas {
     /// Half-size s of the tessellation squares: β = φ(−s + i s) in edge chart a₁.
     pub fn tessellation_square_half(&self) -> Option<f64> {
         let beta = self.polygon()?.constants().beta;
-        let chart = self.charts().iter().find(|c| c.domain() == Domain::Square)?;
+        let chart = self
+            .charts()
+            .iter()
+            .find(|c| c.domain() == Domain::Square)?;
         let w = chart.to_model().inverse().apply(beta);
         Some(0.5 * (w.im - w.re))
     }
@@ -203,7 +259,10 @@ impl Atlas {
         let to_north = self.charts()[0].to_model().inverse();
         let equator: Vec<u32> = (0..arcs)
             .map(|k| {
-                let z = Complex64::from_polar(1.0, std::f64::consts::TAU * f64::from(k) / f64::from(arcs));
+                let z = Complex64::from_polar(
+                    1.0,
+                    std::f64::consts::TAU * f64::from(k) / f64::from(arcs),
+                );
                 b.vertex(ChartPoint::new(north, to_north.apply(z)))
             })
             .collect();
@@ -234,7 +293,10 @@ impl Atlas {
             .collect();
         for &chart in &squares {
             let at = |i: usize, k: usize| {
-                Complex64::new(-s + 2.0 * s * i as f64 / te as f64, -s + 2.0 * s * k as f64 / te as f64)
+                Complex64::new(
+                    -s + 2.0 * s * i as f64 / te as f64,
+                    -s + 2.0 * s * k as f64 / te as f64,
+                )
             };
             let mut grid = vec![0u32; (te + 1) * (te + 1)];
             for k in 0..=te {
@@ -245,9 +307,12 @@ impl Atlas {
                         // Which β this corner is: reduce its image into the polygon, take the nearest.
                         let z = poly.reduce(self.charts()[chart.index()].to_model().apply(w));
                         let which = (0..betas.len())
-                            .min_by(|&x, &y| (betas[x] - z).norm().total_cmp(&(betas[y] - z).norm()))
+                            .min_by(|&x, &y| {
+                                (betas[x] - z).norm().total_cmp(&(betas[y] - z).norm())
+                            })
                             .unwrap_or(0);
-                        *corner_ids[which].get_or_insert_with(|| b.vertex(ChartPoint::new(chart, w)))
+                        *corner_ids[which]
+                            .get_or_insert_with(|| b.vertex(ChartPoint::new(chart, w)))
                     } else {
                         b.vertex(ChartPoint::new(chart, w))
                     };
@@ -261,12 +326,35 @@ impl Atlas {
                     }
                 }
             }
+            // A grid side lies on an arc when both its ends are on the same side of the square.
+            let label = |(i0, k0): (usize, usize), (i1, k1): (usize, usize)| {
+                if i0 == i1 && (i0 == 0 || i0 == te) {
+                    EDGE_INSIDE_ARC
+                } else if k0 == k1 && (k0 == 0 || k0 == te) {
+                    EDGE_VERTEX_ARC
+                } else {
+                    EDGE_INNER
+                }
+            };
             for k in 0..te {
                 for i in 0..te {
-                    let g = |i: usize, k: usize| (grid[k * (te + 1) + i], at(i, k));
-                    let (p00, p10, p11, p01) = (g(i, k), g(i + 1, k), g(i + 1, k + 1), g(i, k + 1));
-                    b.triangle(chart, Region::Square, [p00.0, p10.0, p11.0], [p00.1, p10.1, p11.1]);
-                    b.triangle(chart, Region::Square, [p00.0, p11.0, p01.0], [p00.1, p11.1, p01.1]);
+                    let g = |(i, k): (usize, usize)| (grid[k * (te + 1) + i], at(i, k));
+                    let (q00, q10, q11, q01) = ((i, k), (i + 1, k), (i + 1, k + 1), (i, k + 1));
+                    for tri in [[q00, q10, q11], [q00, q11, q01]] {
+                        let [a, b2, c] = tri.map(g);
+                        let labels = [
+                            label(tri[0], tri[1]),
+                            label(tri[1], tri[2]),
+                            label(tri[2], tri[0]),
+                        ];
+                        b.triangle(
+                            chart,
+                            Region::Square,
+                            [a.0, b2.0, c.0],
+                            [a.1, b2.1, c.1],
+                            labels,
+                        );
+                    }
                 }
             }
         }
@@ -274,8 +362,16 @@ impl Atlas {
             ring.sort_unstable();
             ring.dedup();
         }
-        let inside = self.charts().iter().find(|ch| ch.kind() == ChartKind::Inside).map(|ch| ch.id());
-        let vertex = self.charts().iter().find(|ch| ch.kind() == ChartKind::Vertex).map(|ch| ch.id());
+        let inside = self
+            .charts()
+            .iter()
+            .find(|ch| ch.kind() == ChartKind::Inside)
+            .map(|ch| ch.id());
+        let vertex = self
+            .charts()
+            .iter()
+            .find(|ch| ch.kind() == ChartKind::Vertex)
+            .map(|ch| ch.id());
         let (Some(inside), Some(vertex)) = (inside, vertex) else {
             unreachable!("polygon atlases have an inside and a vertex chart")
         };

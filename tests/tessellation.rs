@@ -1,0 +1,223 @@
+//! The t_e/t_r tessellation, for every genus the issue names and t_e, t_r ∈ {1, 2, 3, 4, 8, 16}:
+//! closed, manifold, orientable, one component, χ = 2 − 2n; counts as documented; no degenerate
+//! triangle; each surface point one vertex; vertex coordinates consistent across charts; and the
+//! triangles, lifted with geodesic edges, tile the surface (areas add up to Gauss–Bonnet's).
+
+use std::f64::consts::PI;
+
+use charts::check::consistency_at;
+use charts::{Atlas, Geometry, Tessellation};
+use ntori::mesh::HalfEdgeMesh;
+use num_complex::Complex64;
+
+const RESOLUTIONS: [u32; 6] = [1, 2, 3, 4, 8, 16];
+
+fn check_genus(genus: u32) {
+    let atlas = Atlas::new(genus).unwrap();
+    for te in RESOLUTIONS {
+        for tr in RESOLUTIONS {
+            let t = atlas
+                .tessellate(te, tr)
+                .unwrap_or_else(|e| panic!("genus {genus} {te}/{tr}: {e}"));
+            let what = format!("genus {genus}, t_e {te}, t_r {tr}");
+            check_topology(genus, &t, &what);
+            check_geometry(&atlas, &t, &what);
+            check_area(&atlas, &t, &what);
+        }
+    }
+}
+
+fn check_topology(genus: u32, t: &Tessellation, what: &str) {
+    assert_eq!(
+        t.vertices.len() as u64,
+        Tessellation::expected_vertices(genus, t.te, t.tr),
+        "{what}"
+    );
+    assert_eq!(
+        t.triangles.len() as u64,
+        Tessellation::expected_triangles(genus, t.te, t.tr),
+        "{what}"
+    );
+    let faces = t
+        .triangles
+        .iter()
+        .zip(&t.triangle_edge_labels)
+        .map(|(f, l)| (&f[..], Some(&l[..])));
+    let mesh = HalfEdgeMesh::from_labelled_polygons(t.vertices.len(), faces).unwrap();
+    let topo = mesh.topology();
+    assert!(
+        topo.closed && topo.manifold && topo.orientable,
+        "{what}: {topo:?}"
+    );
+    assert_eq!(
+        topo.misoriented_edges, 0,
+        "{what}: triangles must be consistently oriented"
+    );
+    assert_eq!(topo.components, 1, "{what}");
+    assert_eq!(
+        topo.euler_characteristic,
+        2 - 2 * i64::from(genus),
+        "{what}"
+    );
+    assert_eq!(topo.genus, Some(genus), "{what}");
+    // From t_e = 2 on, no two edges share both endpoints: the plain vertex-pair mesh (what OBJ, PLY and
+    // STL readers build) is the same closed manifold.
+    if t.te >= 2 {
+        let plain = HalfEdgeMesh::from_polygons(t.vertices.len(), t.triangles.iter().map(|f| &f[..])).unwrap();
+        assert_eq!(plain.topology(), topo, "{what}");
+    }
+}
+
+fn check_geometry(atlas: &Atlas, t: &Tessellation, what: &str) {
+    // No degenerate triangle in its home chart, and its stored corners are its vertices there.
+    for (k, tri) in t.triangles.iter().enumerate() {
+        let [a, b, c] = t.triangle_coords[k];
+        let doubled_area = ((b - a).conj() * (c - a)).im;
+        let longest = (b - a)
+            .norm_sqr()
+            .max((c - b).norm_sqr())
+            .max((a - c).norm_sqr());
+        assert!(
+            doubled_area > 1e-10 * longest,
+            "{what}: triangle {k} degenerate or flipped"
+        );
+        for (corner, &v) in [a, b, c].iter().zip(tri) {
+            let p = atlas.locate_unchecked(t.vertices[v as usize]);
+            let w = p
+                .in_chart(t.triangle_charts[k])
+                .expect("triangle vertex lies in the triangle's chart");
+            assert!((w - corner).norm() <= 1e-12, "{what}: triangle {k}");
+        }
+    }
+    // Every vertex consistent across the charts holding it.
+    for (i, &v) in t.vertices.iter().enumerate() {
+        let c = consistency_at(atlas, v);
+        assert!(c.worst() <= 1e-12, "{what}: vertex {i}: {c:?}");
+    }
+    // No surface point appears twice: compare canonical representations (lowest chart id).
+    let mut canon: Vec<(u32, f64, f64)> = t
+        .vertices
+        .iter()
+        .map(|&v| {
+            let r = atlas.locate_unchecked(v).representations()[0];
+            (r.chart.0, r.coords.re, r.coords.im)
+        })
+        .collect();
+    canon.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    for (i, a) in canon.iter().enumerate() {
+        for b in canon[i + 1..]
+            .iter()
+            .take_while(|b| b.0 == a.0 && b.1 - a.1 < 1e-9)
+        {
+            assert!(
+                (a.2 - b.2).abs() > 1e-9,
+                "{what}: one surface point is two vertices"
+            );
+        }
+    }
+}
+
+/// Area of the geodesic triangle on points near the origin of the Poincaré disk (curvature −1):
+/// π minus the angle sum, the angles signed so that a clockwise triangle comes out negative.
+fn hyperbolic_area(p: [Complex64; 3]) -> f64 {
+    let angle = |a: Complex64, b: Complex64, c: Complex64| {
+        // Move a to the origin; geodesics from the origin are straight.
+        let m = |z: Complex64| (z - a) / (Complex64::ONE - a.conj() * z);
+        (m(c) / m(b)).arg()
+    };
+    let sum = angle(p[0], p[1], p[2]) + angle(p[1], p[2], p[0]) + angle(p[2], p[0], p[1]);
+    (PI - sum.abs()) * sum.signum()
+}
+
+/// Signed area of the spherical triangle (unit sphere) on stereographic coordinates.
+fn spherical_area(p: [Complex64; 3]) -> f64 {
+    let lift = |z: Complex64| {
+        let d = 1.0 + z.norm_sqr();
+        [2.0 * z.re / d, 2.0 * z.im / d, (z.norm_sqr() - 1.0) / d]
+    };
+    let [a, b, c] = p.map(lift);
+    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let triple = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    // Van Oosterom–Strackee. Stereographic projection from the north pole reverses orientation.
+    -2.0 * triple.atan2(1.0 + dot(a, b) + dot(b, c) + dot(c, a))
+}
+
+fn check_area(atlas: &Atlas, t: &Tessellation, what: &str) {
+    let genus = atlas.genus();
+    let (mut total, mut smallest) = (0.0, f64::INFINITY);
+    for (k, coords) in t.triangle_coords.iter().enumerate() {
+        let scale = atlas.charts()[t.triangle_charts[k].index()].scale();
+        let p = coords.map(|w| w * scale);
+        let area = match atlas.geometry() {
+            Geometry::Hyperbolic => hyperbolic_area(p),
+            Geometry::Euclidean => 0.5 * ((p[1] - p[0]).conj() * (p[2] - p[0])).im,
+            Geometry::Spherical => spherical_area(p),
+        };
+        smallest = smallest.min(area);
+        total += area;
+    }
+    assert!(
+        smallest > 0.0,
+        "{what}: a triangle is negatively oriented once lifted"
+    );
+    let want = match atlas.geometry() {
+        Geometry::Hyperbolic => 4.0 * PI * (f64::from(genus) - 1.0),
+        Geometry::Euclidean => 1.0,
+        Geometry::Spherical => 4.0 * PI,
+    };
+    assert!(
+        ((total - want) / want).abs() < 1e-9,
+        "{what}: areas add to {total}, want {want}"
+    );
+}
+
+#[test]
+fn genus_0() {
+    check_genus(0);
+}
+#[test]
+fn genus_1() {
+    check_genus(1);
+}
+#[test]
+fn genus_2() {
+    check_genus(2);
+}
+#[test]
+fn genus_3_and_4() {
+    check_genus(3);
+    check_genus(4);
+}
+#[test]
+fn genus_5_and_8() {
+    check_genus(5);
+    check_genus(8);
+}
+#[test]
+fn genus_16() {
+    check_genus(16);
+}
+#[test]
+fn genus_32() {
+    check_genus(32);
+}
+
+#[test]
+fn bad_resolutions_are_errors() {
+    let atlas = Atlas::new(2).unwrap();
+    for (te, tr) in [
+        (0, 1),
+        (1, 0),
+        (charts::MAX_RESOLUTION + 1, 1),
+        (4000, 4000),
+    ] {
+        assert!(
+            matches!(
+                atlas.tessellate(te, tr),
+                Err(charts::ChartsError::InvalidTessellation(_))
+            ),
+            "{te} {tr}"
+        );
+    }
+}
