@@ -193,6 +193,11 @@ impl HalfEdgeMesh {
         }
     }
 
+    /// The face half-edge h belongs to.
+    pub fn face(&self, h: u32) -> u32 {
+        self.face_of[h as usize]
+    }
+
     pub fn origin(&self, h: u32) -> u32 {
         self.origin[h as usize]
     }
@@ -269,40 +274,44 @@ impl HalfEdgeMesh {
         }
     }
 
-    /// Which vertices are used, and how many used vertices are not manifold: the half-edges leaving a
-    /// manifold vertex form one orbit under h ↦ twin(prev(h)) (the next one around it), a cycle for an
-    /// interior vertex or a chain ending at the boundary. Works for multigraphs too.
+    /// Which vertices are used, and how many used vertices are not manifold. The faces at a manifold
+    /// vertex form one fan or one closed ring: its corners, joined whenever two share an edge at the
+    /// vertex, are connected, and no edge there has more than two corners. Orientation plays no part
+    /// (a misoriented edge still joins its two faces), and multigraphs work through edge labels.
     fn vertex_links(&self) -> (Vec<bool>, usize) {
-        let mut outgoing: Vec<Vec<u32>> = vec![Vec::new(); self.vertex_count];
+        let mut corners: Vec<Vec<u32>> = vec![Vec::new(); self.vertex_count];
         for h in 0..self.origin.len() as u32 {
-            outgoing[self.origin(h) as usize].push(h);
+            corners[self.origin(h) as usize].push(h);
         }
-        let used: Vec<bool> = outgoing.iter().map(|o| !o.is_empty()).collect();
-        let around = |h: u32| self.twin(self.prev(h));
-        let bad = outgoing
+        let used: Vec<bool> = corners.iter().map(|c| !c.is_empty()).collect();
+        let bad = corners
             .iter()
-            .filter(|out| !out.is_empty())
-            .filter(|out| {
-                // Start a chain at a half-edge nothing rotates into, or anywhere on a cycle.
-                let has_pred = |h: u32| out.iter().any(|&g| around(g) == Some(h));
-                let start = out
-                    .iter()
-                    .copied()
-                    .find(|&h| !has_pred(h))
-                    .unwrap_or(out[0]);
-                let mut count = 1;
-                let mut h = start;
-                while let Some(n) = around(h) {
-                    if n == start || count > out.len() {
-                        break;
-                    }
-                    h = n;
-                    count += 1;
-                }
-                count != out.len()
-            })
+            .filter(|c| !c.is_empty() && !self.corners_form_one_fan(c))
             .count();
         (used, bad)
+    }
+
+    /// Corner h at v touches two edges at v: its own (leaving v) and its predecessor's (arriving).
+    fn corners_form_one_fan(&self, corners: &[u32]) -> bool {
+        let mut by_edge: HashMap<EdgeKey, Vec<u32>> = HashMap::new();
+        for (i, &h) in corners.iter().enumerate() {
+            by_edge.entry(self.key(h)).or_default().push(i as u32);
+            by_edge
+                .entry(self.key(self.prev(h)))
+                .or_default()
+                .push(i as u32);
+        }
+        let mut uf = UnionFind::new(corners.len());
+        for at in by_edge.values() {
+            if at.len() > 2 {
+                return false;
+            }
+            if let [a, b] = at[..] {
+                uf.union(a, b);
+            }
+        }
+        let root = uf.find(0);
+        (0..corners.len() as u32).all(|i| uf.find(i) == root)
     }
 
     fn face_components(&self) -> usize {

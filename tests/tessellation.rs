@@ -63,7 +63,9 @@ fn check_topology(genus: u32, t: &Tessellation, what: &str) {
     // From t_e = 2 on, no two edges share both endpoints: the plain vertex-pair mesh (what OBJ, PLY and
     // STL readers build) is the same closed manifold.
     if t.te >= 2 {
-        let plain = HalfEdgeMesh::from_polygons(t.vertices.len(), t.triangles.iter().map(|f| &f[..])).unwrap();
+        let plain =
+            HalfEdgeMesh::from_polygons(t.vertices.len(), t.triangles.iter().map(|f| &f[..]))
+                .unwrap();
         assert_eq!(plain.topology(), topo, "{what}");
     }
 }
