@@ -6,6 +6,7 @@
 pub mod cell_complex;
 pub mod info;
 pub mod mesh;
+pub mod tessellate;
 
 pub use charts;
 pub use embedding;

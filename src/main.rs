@@ -64,6 +64,57 @@ enum Command {
               value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
         points: u64,
     },
+    /// Tessellate the surface (the paper's t_e/t_r scheme) and check the mesh.
+    ///
+    /// The coarsest level (t_e = t_r = 1) cuts the surface into 2n + 2 regions, one per chart: a
+    /// square in each edge chart, sized so that neighbouring squares' corners meet at the point β, and
+    /// two "wheels" (about the inside chart's centre and about the vertex) bounded by the 4n arcs the
+    /// squares leave. t_e divides each square into a t_e × t_e grid and each arc into t_e pieces; t_r
+    /// divides the wheels' spokes. Genus 0 uses two wheels, the caps, meeting at the equator.
+    ///
+    /// Prints V, E, F, the Euler characteristic χ = V − E + F (2 − 2n for genus n), the genus read off
+    /// the mesh, components, and checks: closed, manifold, orientable, consistently oriented; no
+    /// degenerate triangle; vertex coordinates agreeing across charts; and the triangles' areas, with
+    /// geodesic sides, adding up to the surface's area (4π(n − 1) for n ≥ 2). Exit status 3 if a check
+    /// fails.
+    ///
+    /// Examples:
+    ///   ntori tessellate --genus 2 --te 4 --tr 3
+    ///   ntori tessellate --genus 3 --te 1 --tr 1 --svg coarsest.svg   (the paper's figure 7)
+    #[command(verbatim_doc_comment)]
+    Tessellate {
+        /// Genus of the surface: 0 (sphere), 1 (torus), 2 … 64.
+        #[arg(
+            short,
+            long,
+            default_value_t = 2,
+            value_name = "N",
+            allow_negative_numbers = true
+        )]
+        genus: u32,
+        /// Divisions of each square (and each arc).
+        #[arg(
+            long,
+            default_value_t = 4,
+            value_name = "A",
+            allow_negative_numbers = true
+        )]
+        te: u32,
+        /// Divisions of each wheel spoke.
+        #[arg(
+            long,
+            default_value_t = 4,
+            value_name = "B",
+            allow_negative_numbers = true
+        )]
+        tr: u32,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+        /// Also draw the tessellation in the fundamental polygon, charts coloured, to this SVG file.
+        #[arg(long, value_name = "FILE")]
+        svg: Option<std::path::PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -124,5 +175,56 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(3)
             })
         }
+        Command::Tessellate {
+            genus,
+            te,
+            tr,
+            json,
+            svg,
+        } => {
+            let atlas = charts::Atlas::new(genus)
+                .with_context(|| format!("cannot build the charts for genus {genus}"))?;
+            let t = atlas.tessellate(te, tr).with_context(|| {
+                format!("cannot tessellate genus {genus} at t_e = {te}, t_r = {tr}")
+            })?;
+            let report = ntori::tessellate::report(&atlas, &t)?;
+            if let Some(path) = &svg {
+                write_atomically(path, ntori::tessellate::svg(&atlas, &t).as_bytes())?;
+                tracing::info!(path = %path.display(), "wrote the drawing");
+            }
+            let text = if json {
+                serde_json::to_string_pretty(&report)? + "\n"
+            } else {
+                report.to_text()
+            };
+            write_stdout(&text)?;
+            Ok(if report.passed {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(3)
+            })
+        }
     }
+}
+
+/// Writes a file whole or not at all: a temporary file beside it, renamed into place.
+fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).with_context(|| {
+        format!(
+            "cannot write {}: cannot create a file in {}",
+            path.display(),
+            dir.display()
+        )
+    })?;
+    tmp.write_all(bytes)
+        .and_then(|()| tmp.flush())
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    tmp.persist(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
 }

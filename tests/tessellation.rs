@@ -8,7 +8,6 @@ use std::f64::consts::PI;
 use charts::check::consistency_at;
 use charts::{Atlas, Geometry, Tessellation};
 use ntori::mesh::HalfEdgeMesh;
-use num_complex::Complex64;
 
 const RESOLUTIONS: [u32; 6] = [1, 2, 3, 4, 8, 16];
 
@@ -119,46 +118,11 @@ fn check_geometry(atlas: &Atlas, t: &Tessellation, what: &str) {
     }
 }
 
-/// Area of the geodesic triangle on points near the origin of the Poincaré disk (curvature −1):
-/// π minus the angle sum, the angles signed so that a clockwise triangle comes out negative.
-fn hyperbolic_area(p: [Complex64; 3]) -> f64 {
-    let angle = |a: Complex64, b: Complex64, c: Complex64| {
-        // Move a to the origin; geodesics from the origin are straight.
-        let m = |z: Complex64| (z - a) / (Complex64::ONE - a.conj() * z);
-        (m(c) / m(b)).arg()
-    };
-    let sum = angle(p[0], p[1], p[2]) + angle(p[1], p[2], p[0]) + angle(p[2], p[0], p[1]);
-    (PI - sum.abs()) * sum.signum()
-}
-
-/// Signed area of the spherical triangle (unit sphere) on stereographic coordinates.
-fn spherical_area(p: [Complex64; 3]) -> f64 {
-    let lift = |z: Complex64| {
-        let d = 1.0 + z.norm_sqr();
-        [2.0 * z.re / d, 2.0 * z.im / d, (z.norm_sqr() - 1.0) / d]
-    };
-    let [a, b, c] = p.map(lift);
-    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-    let triple = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-        + a[2] * (b[0] * c[1] - b[1] * c[0]);
-    // Van Oosterom–Strackee. Stereographic projection from the north pole reverses orientation.
-    -2.0 * triple.atan2(1.0 + dot(a, b) + dot(b, c) + dot(c, a))
-}
-
 fn check_area(atlas: &Atlas, t: &Tessellation, what: &str) {
     let genus = atlas.genus();
-    let (mut total, mut smallest) = (0.0, f64::INFINITY);
-    for (k, coords) in t.triangle_coords.iter().enumerate() {
-        let scale = atlas.charts()[t.triangle_charts[k].index()].scale();
-        let p = coords.map(|w| w * scale);
-        let area = match atlas.geometry() {
-            Geometry::Hyperbolic => hyperbolic_area(p),
-            Geometry::Euclidean => 0.5 * ((p[1] - p[0]).conj() * (p[2] - p[0])).im,
-            Geometry::Spherical => spherical_area(p),
-        };
-        smallest = smallest.min(area);
-        total += area;
-    }
+    let areas = t.geodesic_areas(atlas);
+    let smallest = areas.iter().copied().fold(f64::INFINITY, f64::min);
+    let total: f64 = areas.iter().sum();
     assert!(
         smallest > 0.0,
         "{what}: a triangle is negatively oriented once lifted"

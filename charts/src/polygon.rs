@@ -322,17 +322,26 @@ impl Polygon {
     /// Brings a model point into the polygon by side pairings: returns the reduced point. Each step
     /// crosses back over the edge the point lies furthest beyond; for a Dirichlet domain centred at the
     /// origin (as here) this strictly decreases the distance to the origin, so it terminates.
-    pub fn reduce(&self, mut z: Complex64) -> Complex64 {
+    pub fn reduce(&self, z: Complex64) -> Complex64 {
+        self.reduce_with_map(z).0
+    }
+
+    /// [`Polygon::reduce`], also returning the group element g it applied (g(z) is the reduced point),
+    /// so that nearby points can be moved along with z.
+    pub fn reduce_with_map(&self, mut z: Complex64) -> (Complex64, crate::Lft) {
+        let mut g = crate::Lft::IDENTITY;
         for _ in 0..10_000 {
             let (e, out) = (0..self.sides())
                 .map(|e| (e, self.outside_edge(z, e)))
                 .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a });
             if out <= 0.0 {
-                return z;
+                break;
             }
-            z = self.cross_f64[e].inverse().apply(z);
+            let step = self.cross_f64[e].inverse();
+            z = step.apply(z);
+            g = step.compose(&g);
         }
-        z
+        (z, g)
     }
 
     /// Follows a corner through the pairing of the edge it leaves by: the tile across edge e sees our

@@ -379,3 +379,82 @@ impl Atlas {
         b.wheel(vertex, Region::VertexWheel, &vertex_ring, "vertex wheel")
     }
 }
+
+impl Tessellation {
+    /// The area of each triangle with geodesic sides through its corners, in the surface's own
+    /// geometry (curvature −1, 0 or +1; the flat torus has area 1, the sphere 4π). Negative for a
+    /// triangle that is clockwise once lifted. Each triangle is measured on `scale·w` in its chart
+    /// (see [`crate::Chart::scale`]), near the origin, where the model is well conditioned.
+    pub fn geodesic_areas(&self, atlas: &Atlas) -> Vec<f64> {
+        self.triangle_coords
+            .iter()
+            .zip(&self.triangle_charts)
+            .map(|(coords, chart)| {
+                let scale = atlas.charts()[chart.index()].scale();
+                let p = coords.map(|w| w * scale);
+                match atlas.geometry() {
+                    crate::Geometry::Hyperbolic => hyperbolic_area(p),
+                    crate::Geometry::Euclidean => 0.5 * ((p[1] - p[0]).conj() * (p[2] - p[0])).im,
+                    crate::Geometry::Spherical => spherical_area(p),
+                }
+            })
+            .collect()
+    }
+}
+
+/// Area of the geodesic triangle on three Poincaré-disk points (curvature −1): π minus the angle
+/// sum, signed by orientation.
+pub fn hyperbolic_area(p: [Complex64; 3]) -> f64 {
+    let angle = |a: Complex64, b: Complex64, c: Complex64| {
+        // Move a to the origin, where geodesics from it are straight.
+        let m = |z: Complex64| (z - a) / (Complex64::ONE - a.conj() * z);
+        (m(c) / m(b)).arg()
+    };
+    let sum = angle(p[0], p[1], p[2]) + angle(p[1], p[2], p[0]) + angle(p[2], p[0], p[1]);
+    (std::f64::consts::PI - sum.abs()) * sum.signum()
+}
+
+/// Signed area of the spherical triangle (unit sphere) on three stereographic coordinates
+/// (Van Oosterom–Strackee).
+pub fn spherical_area(p: [Complex64; 3]) -> f64 {
+    let lift = |z: Complex64| {
+        let d = 1.0 + z.norm_sqr();
+        [2.0 * z.re / d, 2.0 * z.im / d, (z.norm_sqr() - 1.0) / d]
+    };
+    let [a, b, c] = p.map(lift);
+    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let triple = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+        + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    // Projecting from the north pole (ζ ↦ (x, y, z) with z = (|ζ|² − 1)/(|ζ|² + 1)) reverses orientation.
+    -2.0 * triple.atan2(1.0 + dot(a, b) + dot(b, c) + dot(c, a))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn the_polygons_fan_adds_up_to_its_area() {
+        for n in [2, 3, 4] {
+            let poly = crate::Polygon::new(n).unwrap();
+            let c = poly.corners();
+            let total: f64 = (0..c.len())
+                .map(|k| hyperbolic_area([Complex64::ZERO, c[k], c[(k + 1) % c.len()]]))
+                .sum();
+            assert!(
+                (total - 4.0 * PI * (f64::from(n) - 1.0)).abs() < 1e-12,
+                "n = {n}: {total}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_octant_of_the_sphere_has_area_pi_over_two() {
+        // ζ = 0 is the south pole; ζ = 1 and ζ = i are on the equator.
+        let a = spherical_area([Complex64::ZERO, Complex64::ONE, Complex64::I]);
+        assert!((a - PI / 2.0).abs() < 1e-14, "{a}");
+        let flipped = spherical_area([Complex64::ZERO, Complex64::I, Complex64::ONE]);
+        assert!((flipped + PI / 2.0).abs() < 1e-14);
+    }
+}
