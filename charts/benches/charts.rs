@@ -91,5 +91,19 @@ fn build(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, transition_apply, locate, locate_model, build);
+fn tessellate(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tessellate_genus_10");
+    group.sample_size(10);
+    let atlas = Atlas::new(10).unwrap();
+    for t in [32u32, 64] {
+        let triangles = charts::Tessellation::expected_triangles(10, t, t);
+        group.throughput(Throughput::Elements(triangles));
+        group.bench_function(BenchmarkId::from_parameter(t), |b| {
+            b.iter(|| atlas.tessellate(black_box(t), black_box(t)).unwrap().triangles.len())
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, transition_apply, locate, locate_model, build, tessellate);
 criterion_main!(benches);
