@@ -99,11 +99,24 @@ fn tessellate(c: &mut Criterion) {
         let triangles = charts::Tessellation::expected_triangles(10, t, t);
         group.throughput(Throughput::Elements(triangles));
         group.bench_function(BenchmarkId::from_parameter(t), |b| {
-            b.iter(|| atlas.tessellate(black_box(t), black_box(t)).unwrap().triangles.len())
+            b.iter(|| {
+                atlas
+                    .tessellate(black_box(t), black_box(t))
+                    .unwrap()
+                    .triangles
+                    .len()
+            })
         });
     }
     group.finish();
 }
 
-criterion_group!(benches, transition_apply, locate, locate_model, build, tessellate);
+criterion_group!(
+    benches,
+    transition_apply,
+    locate,
+    locate_model,
+    build,
+    tessellate
+);
 criterion_main!(benches);
