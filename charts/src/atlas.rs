@@ -287,18 +287,30 @@ impl Atlas {
 
     /// `locate` for a point already known to lie in its chart's domain.
     pub fn locate_unchecked(&self, p: ChartPoint) -> ManifoldPoint {
+        ManifoldPoint {
+            reps: self
+                .locate_with_transitions(p)
+                .into_iter()
+                .map(|(r, _)| r)
+                .collect(),
+        }
+    }
+
+    /// [`Atlas::locate_unchecked`], with the map from `p`'s chart to each representation's chart (the
+    /// identity for `p` itself), for the chain rule. Sorted by chart.
+    pub fn locate_with_transitions(&self, p: ChartPoint) -> Vec<(ChartPoint, Lft)> {
         let i = p.chart.index();
         let n = self.charts.len();
-        let mut reps = vec![p];
+        let mut reps = vec![(p, Lft::IDENTITY)];
         for &(j, k) in self.locators[i].candidates(p.coords) {
             let t = &self.transitions[i * n + j as usize][k as usize];
             let w = t.apply(p.coords);
             if self.charts[j as usize].domain.contains(w) {
-                reps.push(ChartPoint::new(t.to, w));
+                reps.push((ChartPoint::new(t.to, w), t.lft));
             }
         }
-        reps.sort_by_key(|r| r.chart);
-        ManifoldPoint { reps }
+        reps.sort_by_key(|r| r.0.chart);
+        reps
     }
 
     /// The surface point of a model-space point (any point of the disk, plane, or finite sphere

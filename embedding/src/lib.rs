@@ -1,7 +1,42 @@
 //! # embedding: the surface layer of ntori
 //!
-//! Will hold the spline patch per chart, the blend functions forming a partition of unity, the
-//! surface S(p) with its derivatives, the stencils, the initial fit and the edit solver (issues 4, 5).
-//! It builds on [`charts`] and nothing in `charts` depends on it.
+//! The paper's section 5.1: S(p) = Σ_c b_c(α_c(p)) E_c(α_c(p)) / Σ_c b_c(α_c(p)), with a tensor-product
+//! B-spline patch E_c : chart → R³ and a blend function b_c per chart; normalised, the blends are a
+//! partition of unity. The surface is linear in its control points, so re-embedding a fixed set of
+//! surface points after an edit is a sparse product (`stencil`).
+//!
+//! This crate builds on [`charts`]; it knows nothing of files, windows or GPUs.
+
+pub mod bspline;
+pub mod model;
+pub mod stencil;
+pub mod surface;
+
+pub use model::{MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader};
+pub use stencil::{ColumnIndex, Stencil};
+pub use surface::{Jet, Layout, Point3, SplineSettings, SurfaceJet, Weight};
 
 pub use charts;
+
+/// What can go wrong when building an embedding.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EmbeddingError {
+    #[error("spline degree {0} is not supported (1 to {max})", max = bspline::MAX_DEGREE)]
+    Degree(usize),
+    #[error("a control grid of {count} per side cannot carry degree {degree} (needs {} to 4096)", .degree + 1)]
+    GridSize { count: usize, degree: usize },
+    #[error("continuity order {0} is not supported (1 to 4)")]
+    Continuity(usize),
+    #[error("this is not an ntori model (format \"{0}\")")]
+    NotAModel(String),
+    #[error(
+        "this model was written by a newer ntori (format version {version}; this build reads up to {supported})"
+    )]
+    FutureVersion { version: u32, supported: u32 },
+    #[error("the model's genus or spline settings do not match the layout")]
+    Mismatch,
+    #[error("the model has {found} control points, its settings need {expected}")]
+    ControlCount { found: usize, expected: usize },
+    #[error("control point {0} has a coordinate that is not a finite number")]
+    NotFinite(usize),
+}

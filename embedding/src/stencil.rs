@@ -1,0 +1,137 @@
+//! Stencils: for a fixed set of surface points (a tessellation's vertices), the sparse weights with
+//! positions = W · control points, and the same for the first derivatives that normals need.
+//!
+//! Stored as compressed rows with the weights in separate arrays (structure of arrays), because the
+//! re-embedding loop streams them: a position touches 4 + 8 bytes per weight. A column index (which
+//! rows each control point touches) makes a change to a few control points a sparse update.
+
+use charts::ChartPoint;
+
+use crate::surface::{Layout, Point3, Weight};
+
+/// Sparse weights, one row per surface point.
+#[derive(Clone, Debug, Default)]
+pub struct Stencil {
+    offsets: Vec<usize>,
+    controls: Vec<u32>,
+    pos: Vec<f64>,
+    du: Vec<f64>,
+    dv: Vec<f64>,
+}
+
+/// For each control point, the (row, entry) pairs of the stencil that use it.
+#[derive(Clone, Debug)]
+pub struct ColumnIndex {
+    offsets: Vec<usize>,
+    rows: Vec<u32>,
+    entries: Vec<usize>,
+}
+
+impl Stencil {
+    /// The stencil of `points` (each a point of its own chart).
+    pub fn build(layout: &Layout, points: &[ChartPoint]) -> Stencil {
+        let mut s = Stencil {
+            offsets: Vec::with_capacity(points.len() + 1),
+            ..Stencil::default()
+        };
+        s.offsets.push(0);
+        let mut row: Vec<Weight> = Vec::with_capacity(128);
+        for &p in points {
+            row.clear();
+            layout.weights(p, &mut row);
+            // Merge repeated control points (none today: charts are injective), keep rows sorted.
+            row.sort_unstable_by_key(|w| w.control);
+            for w in &row {
+                s.controls.push(w.control);
+                s.pos.push(w.jet.val);
+                s.du.push(w.jet.du);
+                s.dv.push(w.jet.dv);
+            }
+            s.offsets.push(s.controls.len());
+        }
+        s
+    }
+
+    pub fn rows(&self) -> usize {
+        self.offsets.len() - 1
+    }
+    /// Stored weights (per array).
+    pub fn nonzeros(&self) -> usize {
+        self.controls.len()
+    }
+
+    /// positions = W · control.
+    pub fn positions(&self, control: &[Point3], out: &mut [Point3]) {
+        for (r, o) in out.iter_mut().enumerate().take(self.rows()) {
+            let mut acc = Point3::zeros();
+            for k in self.offsets[r]..self.offsets[r + 1] {
+                acc += control[self.controls[k] as usize] * self.pos[k];
+            }
+            *o = acc;
+        }
+    }
+
+    /// S_u and S_v (in each point's own chart) = W_u · control, W_v · control.
+    pub fn derivatives(&self, control: &[Point3], du: &mut [Point3], dv: &mut [Point3]) {
+        for r in 0..self.rows() {
+            let (mut a, mut b) = (Point3::zeros(), Point3::zeros());
+            for k in self.offsets[r]..self.offsets[r + 1] {
+                let c = control[self.controls[k] as usize];
+                a += c * self.du[k];
+                b += c * self.dv[k];
+            }
+            du[r] = a;
+            dv[r] = b;
+        }
+    }
+
+    /// Unit normals S_u × S_v / |S_u × S_v|.
+    pub fn normals(&self, control: &[Point3], out: &mut [Point3]) {
+        let mut du = vec![Point3::zeros(); self.rows()];
+        let mut dv = vec![Point3::zeros(); self.rows()];
+        self.derivatives(control, &mut du, &mut dv);
+        for (o, (a, b)) in out.iter_mut().zip(du.iter().zip(&dv)) {
+            *o = a.cross(b).normalize();
+        }
+    }
+
+    /// Which rows each of `control_count` control points touches.
+    pub fn column_index(&self, control_count: usize) -> ColumnIndex {
+        let mut counts = vec![0usize; control_count + 1];
+        for &c in &self.controls {
+            counts[c as usize + 1] += 1;
+        }
+        for i in 0..control_count {
+            counts[i + 1] += counts[i];
+        }
+        let mut fill = counts.clone();
+        let mut rows = vec![0u32; self.controls.len()];
+        let mut entries = vec![0usize; self.controls.len()];
+        for r in 0..self.rows() {
+            for k in self.offsets[r]..self.offsets[r + 1] {
+                let c = self.controls[k] as usize;
+                rows[fill[c]] = r as u32;
+                entries[fill[c]] = k;
+                fill[c] += 1;
+            }
+        }
+        ColumnIndex {
+            offsets: counts,
+            rows,
+            entries,
+        }
+    }
+
+    /// After control point `control` moved by `delta`: updates only the positions it touches.
+    pub fn update(
+        &self,
+        index: &ColumnIndex,
+        control: usize,
+        delta: Point3,
+        positions: &mut [Point3],
+    ) {
+        for k in index.offsets[control]..index.offsets[control + 1] {
+            positions[index.rows[k] as usize] += delta * self.pos[index.entries[k]];
+        }
+    }
+}

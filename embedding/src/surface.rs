@@ -1,0 +1,319 @@
+//! The surface S(p) = Σ_c b_c E_c / Σ_c b_c and its derivatives, normal and curvature.
+//!
+//! Everything here comes from one routine, [`Layout::weights`]: for a surface point seen from one of
+//! its charts, the jet (value, first and second derivatives in that chart's coordinates) of every
+//! control point's weight. The surface is Σ weight · control point, so direct evaluation and the
+//! stencils are the same numbers.
+
+use charts::{Atlas, ChartId, ChartPoint, Domain, Lft};
+use nalgebra::Vector3;
+use num_complex::Complex64;
+use serde::{Deserialize, Serialize};
+
+use crate::EmbeddingError;
+use crate::bspline::{UniformBasis, cardinal};
+
+/// A point of R³ (a surface position, a control point). Distinct from chart and model points.
+pub type Point3 = Vector3<f64>;
+
+/// The spline and blend parameters of a model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SplineSettings {
+    /// Degree of the spline patches (3: cubic).
+    pub degree: usize,
+    /// Continuity order k of the blend functions (they vanish with derivatives up to k at the
+    /// chart boundary; the surface is C^k where the patches are).
+    pub continuity: usize,
+    /// Control points per side of each chart's grid.
+    pub grid: usize,
+}
+
+impl Default for SplineSettings {
+    fn default() -> Self {
+        SplineSettings {
+            degree: 3,
+            continuity: 2,
+            grid: 8,
+        }
+    }
+}
+
+/// A value with its first and second derivatives in some chart's coordinates (u, v).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Jet {
+    pub val: f64,
+    pub du: f64,
+    pub dv: f64,
+    pub duu: f64,
+    pub duv: f64,
+    pub dvv: f64,
+}
+
+impl Jet {
+    fn product(a: Jet, b: Jet) -> Jet {
+        Jet {
+            val: a.val * b.val,
+            du: a.du * b.val + a.val * b.du,
+            dv: a.dv * b.val + a.val * b.dv,
+            duu: a.duu * b.val + 2.0 * a.du * b.du + a.val * b.duu,
+            duv: a.duv * b.val + a.du * b.dv + a.dv * b.du + a.val * b.duv,
+            dvv: a.dvv * b.val + 2.0 * a.dv * b.dv + a.val * b.dvv,
+        }
+    }
+
+    /// This jet (in coordinates x + iy) seen through a holomorphic map x + iy = ψ(u + iv) with
+    /// ψ' = d1 and ψ'' = d2 at the point: the chain rule for a conformal change of variables.
+    fn through(self, d1: Complex64, d2: Complex64) -> Jet {
+        let (xu, yu, xv, yv) = (d1.re, d1.im, -d1.im, d1.re);
+        let (xuu, yuu, xuv, yuv, xvv, yvv) = (d2.re, d2.im, -d2.im, d2.re, -d2.re, -d2.im);
+        let (fx, fy, fxx, fxy, fyy) = (self.du, self.dv, self.duu, self.duv, self.dvv);
+        Jet {
+            val: self.val,
+            du: fx * xu + fy * yu,
+            dv: fx * xv + fy * yv,
+            duu: fxx * xu * xu + 2.0 * fxy * xu * yu + fyy * yu * yu + fx * xuu + fy * yuu,
+            duv: fxx * xu * xv + fxy * (xu * yv + xv * yu) + fyy * yu * yv + fx * xuv + fy * yuv,
+            dvv: fxx * xv * xv + 2.0 * fxy * xv * yv + fyy * yv * yv + fx * xvv + fy * yvv,
+        }
+    }
+
+    /// a / b by the quotient rule.
+    fn quotient(a: Jet, b: Jet) -> Jet {
+        let q = a.val / b.val;
+        let qu = (a.du - q * b.du) / b.val;
+        let qv = (a.dv - q * b.dv) / b.val;
+        Jet {
+            val: q,
+            du: qu,
+            dv: qv,
+            duu: (a.duu - 2.0 * qu * b.du - q * b.duu) / b.val,
+            duv: (a.duv - qu * b.dv - qv * b.du - q * b.duv) / b.val,
+            dvv: (a.dvv - 2.0 * qv * b.dv - q * b.dvv) / b.val,
+        }
+    }
+}
+
+/// Position and derivatives of the surface in one chart's coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceJet {
+    pub pos: Point3,
+    pub du: Point3,
+    pub dv: Point3,
+    pub duu: Point3,
+    pub duv: Point3,
+    pub dvv: Point3,
+}
+
+impl SurfaceJet {
+    /// The unit normal S_u × S_v / |S_u × S_v| (outward for a positively oriented embedding).
+    pub fn normal(&self) -> Point3 {
+        self.du.cross(&self.dv).normalize()
+    }
+    /// First fundamental form (E, F, G).
+    pub fn first_form(&self) -> (f64, f64, f64) {
+        (
+            self.du.dot(&self.du),
+            self.du.dot(&self.dv),
+            self.dv.dot(&self.dv),
+        )
+    }
+    /// Second fundamental form (L, M, N) with respect to [`SurfaceJet::normal`].
+    pub fn second_form(&self) -> (f64, f64, f64) {
+        let n = self.normal();
+        (self.duu.dot(&n), self.duv.dot(&n), self.dvv.dot(&n))
+    }
+    /// Gaussian curvature (LN − M²)/(EG − F²).
+    pub fn gaussian_curvature(&self) -> f64 {
+        let ((e, f, g), (l, m, n)) = (self.first_form(), self.second_form());
+        (l * n - m * m) / (e * g - f * f)
+    }
+    /// Mean curvature (EN − 2FM + GL)/(2(EG − F²)).
+    pub fn mean_curvature(&self) -> f64 {
+        let ((e, f, g), (l, m, n)) = (self.first_form(), self.second_form());
+        (e * n - 2.0 * f * m + g * l) / (2.0 * (e * g - f * f))
+    }
+    /// The area element |S_u × S_v|.
+    pub fn area_element(&self) -> f64 {
+        self.du.cross(&self.dv).norm()
+    }
+}
+
+/// How control points are laid out over an atlas: one grid × grid patch per chart, chart-major,
+/// then row-major (index = chart·grid² + j·grid + i for basis i in u, j in v).
+#[derive(Clone, Debug)]
+pub struct Layout<'a> {
+    atlas: &'a Atlas,
+    basis: UniformBasis,
+    settings: SplineSettings,
+}
+
+/// One control point's weight at a surface point: its index and the jet of its weight.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weight {
+    pub control: u32,
+    pub jet: Jet,
+}
+
+impl<'a> Layout<'a> {
+    pub fn new(atlas: &'a Atlas, settings: SplineSettings) -> Result<Layout<'a>, EmbeddingError> {
+        if !(1..=4).contains(&settings.continuity) {
+            return Err(EmbeddingError::Continuity(settings.continuity));
+        }
+        Ok(Layout {
+            atlas,
+            basis: UniformBasis::new(settings.degree, settings.grid)?,
+            settings,
+        })
+    }
+
+    pub fn atlas(&self) -> &'a Atlas {
+        self.atlas
+    }
+    pub fn settings(&self) -> SplineSettings {
+        self.settings
+    }
+    /// Total number of control points.
+    pub fn control_count(&self) -> usize {
+        self.atlas.charts().len() * self.settings.grid * self.settings.grid
+    }
+    pub fn control_index(&self, chart: ChartId, i: usize, j: usize) -> usize {
+        let g = self.settings.grid;
+        chart.index() * g * g + j * g + i
+    }
+
+    /// The unnormalised blend b_c and its derivatives at w in chart c's own coordinates.
+    pub fn raw_blend(&self, domain: Domain, w: Complex64) -> Jet {
+        let d = self.settings.continuity + 1;
+        match domain {
+            Domain::Square => {
+                let (x, y) = (cardinal(d, w.re + 0.5), cardinal(d, w.im + 0.5));
+                Jet {
+                    val: x[0] * y[0],
+                    du: x[1] * y[0],
+                    dv: x[0] * y[1],
+                    duu: x[2] * y[0],
+                    duv: x[1] * y[1],
+                    dvv: x[0] * y[2],
+                }
+            }
+            Domain::Disk => {
+                let r = w.norm();
+                let b = cardinal(d, 0.5 + r);
+                if r < 1e-9 {
+                    // Even about the centre: the gradient vanishes, the Hessian is B''·I.
+                    return Jet {
+                        val: b[0],
+                        duu: b[2],
+                        dvv: b[2],
+                        ..Jet::default()
+                    };
+                }
+                let (ux, uy) = (w.re / r, w.im / r);
+                Jet {
+                    val: b[0],
+                    du: b[1] * ux,
+                    dv: b[1] * uy,
+                    duu: b[2] * ux * ux + b[1] * (1.0 - ux * ux) / r,
+                    duv: b[2] * ux * uy - b[1] * ux * uy / r,
+                    dvv: b[2] * uy * uy + b[1] * (1.0 - uy * uy) / r,
+                }
+            }
+        }
+    }
+
+    /// Every control point's weight at the surface point `p` (a point of `p.chart`), with first and
+    /// second derivatives in `p.chart`'s coordinates. Appends to `out` and returns the normalising
+    /// sum Σ b_c (its jet), which the coverage margin keeps away from zero.
+    pub fn weights(&self, p: ChartPoint, out: &mut Vec<Weight>) -> Jet {
+        let p1 = self.settings.degree + 1;
+        let start = out.len();
+        let mut sum = Jet::default();
+        for (rep, psi) in self.atlas.locate_with_transitions(p) {
+            let chart = &self.atlas.charts()[rep.chart.index()];
+            let w = rep.coords;
+            let (d1, d2) = derivatives(&psi, p.coords);
+            let blend = self.raw_blend(chart.domain(), w).through(d1, d2);
+            add(&mut sum, blend);
+            let (fu, nu) = self.basis.eval(w.re, 2);
+            let (fv, nv) = self.basis.eval(w.im, 2);
+            for j in 0..p1 {
+                for i in 0..p1 {
+                    let basis = Jet {
+                        val: nu[0][i] * nv[0][j],
+                        du: nu[1][i] * nv[0][j],
+                        dv: nu[0][i] * nv[1][j],
+                        duu: nu[2][i] * nv[0][j],
+                        duv: nu[1][i] * nv[1][j],
+                        dvv: nu[0][i] * nv[2][j],
+                    };
+                    out.push(Weight {
+                        control: self.control_index(rep.chart, fu + i, fv + j) as u32,
+                        jet: Jet::product(self.raw_blend(chart.domain(), w), basis).through(d1, d2),
+                    });
+                }
+            }
+        }
+        for weight in &mut out[start..] {
+            weight.jet = Jet::quotient(weight.jet, sum);
+        }
+        sum
+    }
+
+    /// The normalised blend of each chart holding `p` (they sum to 1), in chart order.
+    pub fn blends(&self, p: ChartPoint) -> Vec<(ChartId, f64)> {
+        let reps = self.atlas.locate_with_transitions(p);
+        let raw: Vec<f64> = reps
+            .iter()
+            .map(|(r, _)| {
+                self.raw_blend(self.atlas.charts()[r.chart.index()].domain(), r.coords)
+                    .val
+            })
+            .collect();
+        let total: f64 = raw.iter().sum();
+        reps.iter()
+            .zip(raw)
+            .map(|((r, _), b)| (r.chart, b / total))
+            .collect()
+    }
+
+    /// S and its first and second derivatives at `p`, in `p.chart`'s coordinates.
+    pub fn eval(&self, control: &[Point3], p: ChartPoint) -> SurfaceJet {
+        let mut weights = Vec::with_capacity(64);
+        self.weights(p, &mut weights);
+        let mut s = SurfaceJet {
+            pos: Point3::zeros(),
+            du: Point3::zeros(),
+            dv: Point3::zeros(),
+            duu: Point3::zeros(),
+            duv: Point3::zeros(),
+            dvv: Point3::zeros(),
+        };
+        for w in &weights {
+            let c = control[w.control as usize];
+            s.pos += c * w.jet.val;
+            s.du += c * w.jet.du;
+            s.dv += c * w.jet.dv;
+            s.duu += c * w.jet.duu;
+            s.duv += c * w.jet.duv;
+            s.dvv += c * w.jet.dvv;
+        }
+        s
+    }
+}
+
+fn add(acc: &mut Jet, j: Jet) {
+    acc.val += j.val;
+    acc.du += j.du;
+    acc.dv += j.dv;
+    acc.duu += j.duu;
+    acc.duv += j.duv;
+    acc.dvv += j.dvv;
+}
+
+/// ψ'(w) and ψ''(w) of an LFT with det 1: 1/(cw + d)² and −2c/(cw + d)³.
+fn derivatives(psi: &Lft, w: Complex64) -> (Complex64, Complex64) {
+    let [_, _, c, d] = psi.matrix();
+    let q = c * w + d;
+    let inv = q.inv();
+    (inv * inv, -2.0 * c * inv * inv * inv)
+}

@@ -1,0 +1,481 @@
+//! The embedding: partition of unity, reproduction, convergence, derivatives, continuity across
+//! chart boundaries, stencils.
+
+use std::sync::OnceLock;
+
+use charts::{Atlas, ChartId, ChartPoint, Domain};
+use embedding::bspline::UniformBasis;
+use embedding::{Layout, Model, Point3, SplineSettings, Stencil};
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
+use proptest::prelude::*;
+
+fn atlas(genus: u32) -> &'static Atlas {
+    static ATLASES: [OnceLock<Atlas>; 33] = [const { OnceLock::new() }; 33];
+    ATLASES[genus as usize].get_or_init(|| Atlas::new(genus).unwrap())
+}
+
+fn chart_point(atlas: &Atlas, chart: usize, u: f64, v: f64) -> ChartPoint {
+    let id = ChartId((chart % atlas.charts().len()) as u32);
+    let w = match atlas.charts()[id.index()].domain() {
+        Domain::Square => Complex64::new(u - 0.5, v - 0.5) * (1.0 - 1e-9),
+        Domain::Disk => {
+            Complex64::from_polar(0.5 * u.sqrt() * (1.0 - 1e-9), std::f64::consts::TAU * v)
+        }
+    };
+    ChartPoint::new(id, w)
+}
+
+/// Deterministic pseudo-random control points (each chart's patch differs, so blending matters).
+fn noisy_controls(layout: &Layout, seed: u64) -> Vec<Point3> {
+    let mut x = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut next = || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    (0..layout.control_count())
+        .map(|_| Point3::new(next(), next(), next()))
+        .collect()
+}
+
+fn check_unity(genus: u32, p: ChartPoint) -> Result<(), TestCaseError> {
+    let layout = Layout::new(atlas(genus), SplineSettings::default()).unwrap();
+    let blends = layout.blends(p);
+    let sum: f64 = blends.iter().map(|b| b.1).sum();
+    prop_assert!((sum - 1.0).abs() <= 1e-12, "Σ b = {sum} at {p:?}");
+    prop_assert!(blends.iter().all(|b| b.1 >= 0.0));
+    // The same blends seen from every other chart holding the point (away from the boundary band).
+    for rep in atlas(genus).locate_unchecked(p).representations() {
+        let margin = atlas(genus).charts()[rep.chart.index()]
+            .domain()
+            .margin(rep.coords);
+        if margin < 1e-9 {
+            continue;
+        }
+        let again = layout.blends(*rep);
+        for (a, b) in blends
+            .iter()
+            .filter(|b| b.1 > 1e-9)
+            .zip(again.iter().filter(|b| b.1 > 1e-9))
+        {
+            prop_assert_eq!(a.0, b.0);
+            prop_assert!(
+                (a.1 - b.1).abs() <= 1e-12,
+                "blend of {} differs by {:e}",
+                a.0,
+                (a.1 - b.1).abs()
+            );
+        }
+    }
+    Ok(())
+}
+
+macro_rules! unity {
+    ($($name:ident: $genus:expr,)*) => {$(
+        proptest! {
+            #![proptest_config(ProptestConfig { cases: 100_000, failure_persistence: None, ..ProptestConfig::default() })]
+            #[test]
+            fn $name(chart in 0usize..1000, u in 0.0f64..1.0, v in 0.0f64..1.0) {
+                check_unity($genus, chart_point(atlas($genus), chart, u, v))?;
+            }
+        }
+    )*};
+}
+
+unity! {
+    partition_of_unity_genus_0: 0, partition_of_unity_genus_1: 1, partition_of_unity_genus_2: 2,
+    partition_of_unity_genus_3: 3, partition_of_unity_genus_4: 4, partition_of_unity_genus_5: 5,
+    partition_of_unity_genus_6: 6, partition_of_unity_genus_7: 7, partition_of_unity_genus_8: 8,
+    partition_of_unity_genus_16: 16, partition_of_unity_genus_32: 32,
+}
+
+#[test]
+fn constant_patches_give_a_point() {
+    for genus in [0, 1, 2, 5] {
+        let layout = Layout::new(atlas(genus), SplineSettings::default()).unwrap();
+        let c = Point3::new(0.3, -1.2, 2.5);
+        let control = Model::constant(&layout, c).points();
+        for k in 0..2000 {
+            let p = chart_point(
+                atlas(genus),
+                k,
+                (k as f64 * 0.618).fract(),
+                (k as f64 * 0.414).fract(),
+            );
+            let s = layout.eval(&control, p);
+            assert!(
+                (s.pos - c).norm() < 1e-12 && s.du.norm() < 1e-10 && s.duu.norm() < 1e-8,
+                "genus {genus}"
+            );
+        }
+    }
+}
+
+/// Least-squares coefficients of `f` sampled at `xs` in the 1D basis.
+fn fit_1d(basis: &UniformBasis, xs: &[f64], f: impl Fn(f64) -> f64) -> DVector<f64> {
+    let m = basis.count();
+    let mut a = DMatrix::zeros(xs.len(), m);
+    for (r, &x) in xs.iter().enumerate() {
+        let (first, v) = basis.eval(x, 0);
+        for j in 0..=basis.degree() {
+            a[(r, first + j)] = v[0][j];
+        }
+    }
+    let b = DVector::from_iterator(xs.len(), xs.iter().map(|&x| f(x)));
+    a.svd(true, true).solve(&b, 1e-14).unwrap()
+}
+
+fn eval_1d(basis: &UniformBasis, coef: &DVector<f64>, x: f64) -> f64 {
+    let (first, v) = basis.eval(x, 0);
+    (0..=basis.degree())
+        .map(|j| v[0][j] * coef[first + j])
+        .sum()
+}
+
+#[test]
+fn splines_reproduce_polynomials_up_to_their_degree() {
+    for p in 1..=5 {
+        let basis = UniformBasis::new(p, p + 5).unwrap();
+        let xs: Vec<f64> = (0..200).map(|i| -0.5 + i as f64 / 199.0).collect();
+        for k in 0..=p {
+            let coef = fit_1d(&basis, &xs, |x| (x + 0.2).powi(k as i32));
+            let err = (0..500)
+                .map(|i| -0.5 + i as f64 / 499.0)
+                .map(|x| (eval_1d(&basis, &coef, x) - (x + 0.2).powi(k as i32)).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-12, "degree {p} misses x^{k} by {err:e}");
+        }
+        // One degree more is not reproduced.
+        let coef = fit_1d(&basis, &xs, |x| x.powi(p as i32 + 1));
+        let err = (0..500)
+            .map(|i| -0.5 + i as f64 / 499.0)
+            .map(|x| (eval_1d(&basis, &coef, x) - x.powi(p as i32 + 1)).abs())
+            .fold(0.0, f64::max);
+        assert!(err > 1e-6, "degree {p} should not reproduce x^{}", p + 1);
+    }
+}
+
+#[test]
+fn fitting_converges_at_the_order_the_degree_predicts() {
+    // A smooth target on a patch, fitted by tensor-product least squares on a grid of samples (which
+    // separates into 1D fits); max error on a finer grid. Error ~ h^(p+1).
+    let target = |x: f64, y: f64| (3.0 * x).sin() * (2.0 * y + 0.3).cos() + x * x * y;
+    for p in [2usize, 3, 4] {
+        let mut errors = Vec::new();
+        for m in [8usize, 16, 32] {
+            let basis = UniformBasis::new(p, m + p).unwrap();
+            let xs: Vec<f64> = (0..4 * (m + p))
+                .map(|i| -0.5 + (i as f64 + 0.5) / (4 * (m + p)) as f64)
+                .collect();
+            // Fit each row in x, then each column of coefficients in y.
+            let rows: Vec<DVector<f64>> = xs
+                .iter()
+                .map(|&y| fit_1d(&basis, &xs, |x| target(x, y)))
+                .collect();
+            let n = basis.count();
+            let coef: Vec<DVector<f64>> = (0..n)
+                .map(|i| {
+                    let col: Vec<f64> = rows.iter().map(|r| r[i]).collect();
+                    fit_1d(&basis, &xs, |y| {
+                        let k = xs.iter().position(|&v| v == y).unwrap();
+                        col[k]
+                    })
+                })
+                .collect();
+            let err = (0..60)
+                .flat_map(|a| {
+                    (0..60).map(move |b| (-0.5 + a as f64 / 59.0, -0.5 + b as f64 / 59.0))
+                })
+                .map(|(x, y)| {
+                    let vx: Vec<f64> = (0..n).map(|i| eval_1d(&basis, &coef[i], y)).collect();
+                    let vx = DVector::from_vec(vx);
+                    (eval_1d(&basis, &vx, x) - target(x, y)).abs()
+                })
+                .fold(0.0, f64::max);
+            errors.push(err);
+        }
+        let orders: Vec<f64> = errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect();
+        println!(
+            "degree {p}: errors {errors:?}, observed orders {orders:.2?} (predicted {})",
+            p + 1
+        );
+        assert!(
+            orders.iter().all(|&o| o > p as f64 + 0.5),
+            "degree {p}: orders {orders:?}"
+        );
+    }
+}
+
+#[test]
+fn analytic_derivatives_agree_with_finite_differences() {
+    for genus in [0, 1, 2, 3] {
+        let layout = Layout::new(atlas(genus), SplineSettings::default()).unwrap();
+        let control = noisy_controls(&layout, 7 + u64::from(genus));
+        for k in 0..300 {
+            let p = chart_point(
+                atlas(genus),
+                k,
+                0.05 + 0.9 * (k as f64 * 0.618).fract(),
+                (k as f64 * 0.414).fract(),
+            );
+            let s = layout.eval(&control, p);
+            let at = |dw: Complex64| layout.eval(&control, ChartPoint::new(p.chart, p.coords + dw));
+            // Central differences of S: error O(h²) (S''' is bounded), so halving h quarters it. Of S_u
+            // for the second derivatives: O(h²) away from knots, but S''' jumps across spline knot
+            // lines (cubic patches are C²), and within h of one the error is O(h): halving h at
+            // least halves it.
+            let err = |h: f64| {
+                let (u1, u0) = (at(Complex64::new(h, 0.0)), at(Complex64::new(-h, 0.0)));
+                let (v1, v0) = (at(Complex64::new(0.0, h)), at(Complex64::new(0.0, -h)));
+                let first = ((u1.pos - u0.pos) / (2.0 * h) - s.du)
+                    .norm()
+                    .max(((v1.pos - v0.pos) / (2.0 * h) - s.dv).norm());
+                let second = ((u1.du - u0.du) / (2.0 * h) - s.duu)
+                    .norm()
+                    .max(((v1.du - v0.du) / (2.0 * h) - s.duv).norm())
+                    .max(((v1.dv - v0.dv) / (2.0 * h) - s.dvv).norm());
+                (first, second)
+            };
+            let ((f1, s1), (f2, s2)) = (err(2e-4), err(1e-4));
+            let scale = 1.0 + s.duu.norm() + s.dvv.norm() + s.du.norm();
+            assert!(
+                f2 < 1e-5 * scale,
+                "genus {genus}, {p:?}: first derivatives off by {f2:e}"
+            );
+            // Second derivatives: O(h)·(jump of S''') on a knot line, so only loosely bounded here.
+            assert!(
+                s2 < 1e-1 * scale,
+                "genus {genus}, {p:?}: second derivatives off by {s2:e}"
+            );
+            assert!(
+                f2 < 0.35 * f1 || f2 < 1e-9 * scale,
+                "genus {genus}: S_u not second order ({f1:e} → {f2:e})"
+            );
+            assert!(
+                s2 < 0.6 * s1 || s2 < 1e-7 * scale,
+                "genus {genus}: S_uu not first order ({s1:e} → {s2:e})"
+            );
+        }
+    }
+}
+
+/// max_n |D_j(t_{n+1}) − D_j(t_n)| / h for the j-th finite-difference derivative along a path.
+fn variation(f: &impl Fn(f64) -> Point3, j: usize, t0: f64, t1: f64, h: f64) -> f64 {
+    let d = |t: f64| match j {
+        1 => (f(t + h) - f(t - h)) / (2.0 * h),
+        2 => (f(t + h) - 2.0 * f(t) + f(t - h)) / (h * h),
+        _ => {
+            (f(t + 2.0 * h) - 2.0 * f(t + h) + 2.0 * f(t - h) - f(t - 2.0 * h)) / (2.0 * h * h * h)
+        }
+    };
+    let n = ((t1 - t0) / h) as usize;
+    let values: Vec<Point3> = (0..=n).map(|i| d(t0 + i as f64 * h)).collect();
+    values
+        .windows(2)
+        .map(|w| (w[1] - w[0]).norm())
+        .fold(0.0, f64::max)
+        / h
+}
+
+#[test]
+fn the_surface_is_ck_across_every_kind_of_chart_boundary() {
+    let genus = 2;
+    let atlas = atlas(genus);
+    // Paths in chart coordinates: across the polygon's edge (edge chart, a through 0); along an edge
+    // past the corners' regions (other edge charts' and the vertex chart's blend supports); through the
+    // vertex itself (the vertex chart's centre, where all 4n corners meet); out of the inside chart.
+    let paths = [
+        (
+            ChartId(2),
+            Complex64::new(-0.45, 0.05),
+            Complex64::new(0.45, 0.05),
+        ),
+        (
+            ChartId(2),
+            Complex64::new(-0.1, -0.45),
+            Complex64::new(-0.1, 0.45),
+        ),
+        (
+            ChartId(1),
+            Complex64::new(-0.4, -0.12),
+            Complex64::new(0.4, 0.12),
+        ),
+        (
+            ChartId(0),
+            Complex64::new(0.05, 0.02),
+            Complex64::new(0.45, 0.2),
+        ),
+    ];
+    // Which chart boundaries the paths cross: record membership changes along each.
+    let mut crossed = std::collections::BTreeSet::new();
+    for &(chart, a, b) in &paths {
+        let members = |t: f64| -> Vec<u32> {
+            atlas
+                .locate_unchecked(ChartPoint::new(chart, a + (b - a) * t))
+                .representations()
+                .iter()
+                .map(|r| r.chart.0)
+                .collect()
+        };
+        let mut prev = members(0.0);
+        for i in 1..=2000 {
+            let now = members(i as f64 / 2000.0);
+            for c in prev
+                .iter()
+                .filter(|c| !now.contains(c))
+                .chain(now.iter().filter(|c| !prev.contains(c)))
+            {
+                crossed.insert(
+                    atlas.charts()[*c as usize]
+                        .kind()
+                        .label()
+                        .split(' ')
+                        .next()
+                        .unwrap()
+                        .to_string(),
+                );
+            }
+            prev = now;
+        }
+    }
+    assert!(
+        crossed.contains("inside") && crossed.contains("vertex") && crossed.contains("edge"),
+        "{crossed:?}"
+    );
+    let poly = atlas.polygon().unwrap();
+    let leaves_polygon = |(chart, a, b): (ChartId, Complex64, Complex64)| {
+        (0..=100).any(|i| {
+            !poly.contains(
+                atlas
+                    .to_model(ChartPoint::new(chart, a + (b - a) * (i as f64 / 100.0)))
+                    .unwrap()
+                    .0,
+                0.0,
+            )
+        })
+    };
+    assert!(
+        leaves_polygon(paths[0]),
+        "path 0 crosses the polygon's edge"
+    );
+
+    for (k, degree) in [(1usize, 3usize), (2, 3), (3, 4)] {
+        let layout = Layout::new(
+            atlas,
+            SplineSettings {
+                degree,
+                continuity: k,
+                grid: 8,
+            },
+        )
+        .unwrap();
+        let control = noisy_controls(&layout, 11);
+        let mut jump_seen = false;
+        for &(chart, a, b) in &paths {
+            let f = |t: f64| {
+                layout
+                    .eval(&control, ChartPoint::new(chart, a + (b - a) * t))
+                    .pos
+            };
+            let (t0, t1) = (0.01, 0.99);
+            for j in 1..=k {
+                let (r1, r2) = (
+                    variation(&f, j, t0, t1, 2e-3),
+                    variation(&f, j, t0, t1, 1e-3),
+                );
+                // Continuous: the variation per step scales with h, so r stays put; a jump doubles it.
+                assert!(
+                    r2 < 1.5 * r1,
+                    "k = {k}: derivative {j} jumps on path {chart} ({r1:e} → {r2:e})"
+                );
+            }
+            let (r1, r2) = (
+                variation(&f, k + 1, t0, t1, 2e-3),
+                variation(&f, k + 1, t0, t1, 1e-3),
+            );
+            jump_seen |= r2 > 1.7 * r1;
+        }
+        // The detector is not blind: with C^k blends, derivative k + 1 does jump somewhere.
+        if k < 3 {
+            assert!(
+                jump_seen,
+                "k = {k}: expected derivative {} to jump somewhere",
+                k + 1
+            );
+        }
+    }
+}
+
+#[test]
+fn stencils_equal_direct_evaluation_and_update_in_part() {
+    for genus in [0, 1, 2, 3] {
+        let atlas = atlas(genus);
+        let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
+        let mut control = noisy_controls(&layout, 3);
+        let t = atlas.tessellate(4, 3).unwrap();
+        let stencil = Stencil::build(&layout, &t.vertices);
+        let mut pos = vec![Point3::zeros(); t.vertices.len()];
+        stencil.positions(&control, &mut pos);
+        let (mut du, mut dv) = (pos.clone(), pos.clone());
+        stencil.derivatives(&control, &mut du, &mut dv);
+        for (i, &v) in t.vertices.iter().enumerate() {
+            let s = layout.eval(&control, v);
+            assert!((s.pos - pos[i]).norm() <= 1e-12, "genus {genus}");
+            assert!((s.du - du[i]).norm() <= 1e-12 && (s.dv - dv[i]).norm() <= 1e-12);
+        }
+        // Move a few control points; the partial update equals a full re-evaluation.
+        let index = stencil.column_index(layout.control_count());
+        for (n, c) in [5usize, 77, layout.control_count() - 1]
+            .into_iter()
+            .enumerate()
+        {
+            let delta = Point3::new(0.1, -0.2 * n as f64, 0.05);
+            control[c] += delta;
+            stencil.update(&index, c, delta, &mut pos);
+        }
+        let mut full = vec![Point3::zeros(); t.vertices.len()];
+        stencil.positions(&control, &mut full);
+        let worst = pos
+            .iter()
+            .zip(&full)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        assert!(
+            worst <= 1e-12,
+            "genus {genus}: partial update off by {worst:e}"
+        );
+    }
+}
+
+#[test]
+fn models_round_trip_and_refuse_newer_versions() {
+    let layout = Layout::new(atlas(2), SplineSettings::default()).unwrap();
+    let mut model = Model::constant(&layout, Point3::new(1.0, 2.0, 3.0));
+    model.control_points[3] = [0.1, f64::MIN_POSITIVE, -7.25];
+    let json = serde_json::to_string(&model).unwrap();
+    let back: Model = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, model);
+    assert!(back.validate(&layout).is_ok());
+    let header: embedding::ModelHeader =
+        serde_json::from_str(&json.replace("\"version\":1", "\"version\":99")).unwrap();
+    assert!(matches!(
+        header.check(),
+        Err(embedding::EmbeddingError::FutureVersion { version: 99, .. })
+    ));
+    let mut broken = model.clone();
+    broken.control_points.pop();
+    assert!(matches!(
+        broken.validate(&layout),
+        Err(embedding::EmbeddingError::ControlCount { .. })
+    ));
+    broken = model;
+    broken.control_points[0][1] = f64::NAN;
+    assert!(matches!(
+        broken.validate(&layout),
+        Err(embedding::EmbeddingError::NotFinite(0))
+    ));
+}
