@@ -5,6 +5,20 @@
 //! partition of unity. The surface is linear in its control points, so re-embedding a fixed set of
 //! surface points after an edit is a sparse product (`stencil`).
 //!
+//! ```
+//! use charts::{Atlas, ChartId, ChartPoint};
+//! use embedding::{Layout, Model, Point3, SplineSettings};
+//! use num_complex::Complex64;
+//!
+//! let atlas = Atlas::new(2)?;
+//! let layout = Layout::new(&atlas, SplineSettings::default())?;
+//! // Every control point at the same place: the surface is that point.
+//! let model = Model::constant(&layout, Point3::new(1.0, 0.0, 0.0));
+//! let s = layout.eval(&model.points(), ChartPoint::new(ChartId(2), Complex64::new(0.1, 0.2)));
+//! assert!((s.pos - Point3::new(1.0, 0.0, 0.0)).norm() < 1e-12);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! This crate builds on [`charts`]; it knows nothing of files, windows or GPUs.
 
 pub mod bspline;

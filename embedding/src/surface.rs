@@ -232,23 +232,28 @@ impl<'a> Layout<'a> {
             let chart = &self.atlas.charts()[rep.chart.index()];
             let w = rep.coords;
             let (d1, d2) = derivatives(&psi, p.coords);
-            let blend = self.raw_blend(chart.domain(), w).through(d1, d2);
-            add(&mut sum, blend);
+            let raw = self.raw_blend(chart.domain(), w);
+            add(&mut sum, raw.through(d1, d2));
             let (fu, nu) = self.basis.eval(w.re, 2);
             let (fv, nv) = self.basis.eval(w.im, 2);
-            for j in 0..p1 {
-                for i in 0..p1 {
+            // (value, first, second derivative) of each of the p + 1 basis functions alive here.
+            let triples = |n: &[[f64; crate::bspline::MAX_DEGREE + 1]; 4]| -> Vec<[f64; 3]> {
+                (0..p1).map(|k| [n[0][k], n[1][k], n[2][k]]).collect()
+            };
+            let (bu, bv) = (triples(&nu), triples(&nv));
+            for (j, y) in bv.iter().enumerate() {
+                for (i, x) in bu.iter().enumerate() {
                     let basis = Jet {
-                        val: nu[0][i] * nv[0][j],
-                        du: nu[1][i] * nv[0][j],
-                        dv: nu[0][i] * nv[1][j],
-                        duu: nu[2][i] * nv[0][j],
-                        duv: nu[1][i] * nv[1][j],
-                        dvv: nu[0][i] * nv[2][j],
+                        val: x[0] * y[0],
+                        du: x[1] * y[0],
+                        dv: x[0] * y[1],
+                        duu: x[2] * y[0],
+                        duv: x[1] * y[1],
+                        dvv: x[0] * y[2],
                     };
                     out.push(Weight {
                         control: self.control_index(rep.chart, fu + i, fv + j) as u32,
-                        jet: Jet::product(self.raw_blend(chart.domain(), w), basis).through(d1, d2),
+                        jet: Jet::product(raw, basis).through(d1, d2),
                     });
                 }
             }

@@ -479,3 +479,58 @@ fn models_round_trip_and_refuse_newer_versions() {
         Err(embedding::EmbeddingError::NotFinite(0))
     ));
 }
+
+#[test]
+fn curvature_and_normals_do_not_depend_on_the_chart() {
+    // K and H are invariants of the surface: computed in any chart holding a point, they agree (the
+    // transitions are orientation-preserving, so the normal and the sign of H agree too).
+    for genus in [0, 1, 2, 3, 8] {
+        let atlas = atlas(genus);
+        let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
+        let control = noisy_controls(&layout, 5);
+        let mut compared = 0;
+        for k in 0..3000 {
+            let p = chart_point(
+                atlas,
+                k,
+                (k as f64 * 0.618).fract(),
+                (k as f64 * 0.414).fract(),
+            );
+            let s = layout.eval(&control, p);
+            for rep in atlas
+                .locate_unchecked(p)
+                .representations()
+                .iter()
+                .filter(|r| r.chart != p.chart)
+            {
+                if atlas.charts()[rep.chart.index()]
+                    .domain()
+                    .margin(rep.coords)
+                    < 1e-6
+                {
+                    continue;
+                }
+                let t = layout.eval(&control, *rep);
+                let tol = 1e-8 * (1.0 + s.gaussian_curvature().abs());
+                assert!((s.pos - t.pos).norm() < 1e-12);
+                assert!(
+                    (s.normal() - t.normal()).norm() < 1e-9,
+                    "genus {genus}: normals differ"
+                );
+                assert!(
+                    (s.gaussian_curvature() - t.gaussian_curvature()).abs() < tol,
+                    "genus {genus}: K differs"
+                );
+                assert!(
+                    (s.mean_curvature() - t.mean_curvature()).abs()
+                        < 1e-8 * (1.0 + s.mean_curvature().abs())
+                );
+                compared += 1;
+            }
+        }
+        assert!(
+            compared > 1000,
+            "genus {genus}: only {compared} overlaps compared"
+        );
+    }
+}
