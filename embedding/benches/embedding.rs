@@ -142,5 +142,49 @@ fn bandwidth_report(_: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, direct_and_build, reembed, bandwidth_report);
+/// One drag event: solve the least-norm edit (a dragged point and two pins), apply it, and bring the
+/// affected vertex positions up to date from the stencil.
+fn drag_event(c: &mut Criterion) {
+    use embedding::edit::{Constraint, RefreshScratch, refresh, solve};
+    let atlas = Atlas::new(2).unwrap();
+    let layout = Layout::new(&atlas, SplineSettings::default()).unwrap();
+    let mut control = controls(&layout);
+    let mut group = c.benchmark_group("drag_event");
+    group.sample_size(20);
+    for n in [100_000usize, 1_000_000] {
+        let pts = points(&atlas, n);
+        let s = Stencil::build(&layout, &pts);
+        let index = s.column_index(layout.control_count());
+        let mut out = vec![Point3::zeros(); s.rows()];
+        s.positions(&control, &mut out);
+        let (dragged, pins) = (pts[n / 3], [pts[n / 7], pts[n / 2]]);
+        let mut scratch = RefreshScratch::default();
+        let mut step = 0.0;
+        group.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| {
+                step += 1e-4;
+                let mut constraints = vec![Constraint {
+                    point: dragged,
+                    target: out[n / 3] + Point3::new(step, 0.0, 0.0),
+                }];
+                constraints.extend(pins.iter().map(|&p| Constraint {
+                    point: p,
+                    target: layout.eval(&control, p).pos,
+                }));
+                let edit = solve(&layout, &control, &constraints).unwrap();
+                edit.apply(&mut control);
+                refresh(&s, &index, &edit, &control, &mut out, &mut scratch);
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    direct_and_build,
+    reembed,
+    bandwidth_report,
+    drag_event
+);
 criterion_main!(benches);

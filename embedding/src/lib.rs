@@ -22,6 +22,7 @@
 //! This crate builds on [`charts`]; it knows nothing of files, windows or GPUs.
 
 pub mod bspline;
+pub mod edit;
 pub mod model;
 pub mod stencil;
 pub mod surface;
@@ -53,4 +54,10 @@ pub enum EmbeddingError {
     ControlCount { found: usize, expected: usize },
     #[error("control point {0} has a coordinate that is not a finite number")]
     NotFinite(usize),
+    #[error("constraint {0} asks for a position that is not a finite point")]
+    BadTarget(usize),
+    #[error("the edit's constraints could not be solved")]
+    Unsolvable,
+    #[error(transparent)]
+    Chart(#[from] charts::ChartsError),
 }

@@ -63,12 +63,23 @@ impl Stencil {
     /// positions = W · control.
     pub fn positions(&self, control: &[Point3], out: &mut [Point3]) {
         for (r, o) in out.iter_mut().enumerate().take(self.rows()) {
-            let mut acc = Point3::zeros();
-            for k in self.offsets[r]..self.offsets[r + 1] {
-                acc += control[self.controls[k] as usize] * self.pos[k];
-            }
-            *o = acc;
+            *o = self.position(control, r);
         }
+    }
+
+    /// Row r of W · control.
+    #[inline]
+    pub fn position(&self, control: &[Point3], r: usize) -> Point3 {
+        let mut acc = Point3::zeros();
+        for k in self.offsets[r]..self.offsets[r + 1] {
+            acc += control[self.controls[k] as usize] * self.pos[k];
+        }
+        acc
+    }
+
+    /// The rows that control point `control` touches.
+    pub fn rows_of<'a>(&self, index: &'a ColumnIndex, control: usize) -> &'a [u32] {
+        &index.rows[index.offsets[control]..index.offsets[control + 1]]
     }
 
     /// S_u and S_v (in each point's own chart) = W_u · control, W_v · control.
