@@ -3,6 +3,7 @@
 //! The application layer: the command line (and, in later work, the model file, meshes, export, the
 //! renderer and the editor) over the [`charts`] and [`embedding`] crates.
 
+pub mod bench;
 pub mod cell_complex;
 pub mod info;
 pub mod mesh;

@@ -115,6 +115,30 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         svg: Option<std::path::PathBuf>,
     },
+    /// Measure throughput and print JSON: tessellation, point location, stencil building,
+    /// re-embedding (also as a fraction of memory copy bandwidth) and drag events. Baselines (copy
+    /// bandwidth, a chain of scalar multiply-adds) are measured in the same run, and every figure is
+    /// also given per baseline operation, since this machine is shared and noisy.
+    ///
+    /// For statistics and history use `cargo bench`; this is the quick look.
+    Bench {
+        /// Genus of the surface.
+        #[arg(
+            short,
+            long,
+            default_value_t = 2,
+            value_name = "N",
+            allow_negative_numbers = true
+        )]
+        genus: u32,
+        /// About how many vertices to measure with.
+        #[arg(long, default_value_t = 100_000, value_name = "V",
+              value_parser = clap::value_parser!(u64).range(10..=5_000_000))]
+        vertices: u64,
+        /// No progress messages on stderr.
+        #[arg(short, long)]
+        quiet: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -175,6 +199,11 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(3)
             })
         }
+        Command::Bench {
+            genus,
+            vertices,
+            quiet,
+        } => bench(genus, vertices, quiet),
         Command::Tessellate {
             genus,
             te,
@@ -205,6 +234,21 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             })
         }
     }
+}
+
+fn bench(genus: u32, vertices: u64, quiet: bool) -> anyhow::Result<ExitCode> {
+    let bar = if quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new_spinner()
+    };
+    let report = ntori::bench::run(genus, vertices as usize, &|stage| {
+        bar.set_message(format!("measuring {stage}"));
+        bar.tick();
+    })?;
+    bar.finish_and_clear();
+    write_stdout(&(serde_json::to_string_pretty(&report)? + "\n"))?;
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Writes a file whole or not at all: a temporary file beside it, renamed into place.

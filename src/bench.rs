@@ -1,0 +1,164 @@
+//! `ntori bench`: quick throughput figures as JSON, each also as a ratio to baselines measured in the
+//! same run (this machine is shared and noisy; ratios travel better than seconds).
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use charts::{Atlas, ChartPoint};
+use embedding::edit::{Constraint, RefreshScratch, refresh, solve};
+use embedding::{Layout, Point3, SplineSettings, Stencil};
+use serde::Serialize;
+
+/// One measured figure.
+#[derive(Debug, Serialize)]
+pub struct Figure {
+    pub name: String,
+    /// Items per second (points, vertices, triangles, events).
+    pub per_second: f64,
+    pub unit: &'static str,
+    /// per_second × bytes per item ÷ copy bandwidth, where the figure is memory-bound.
+    pub fraction_of_copy_bandwidth: Option<f64>,
+    /// per_second ÷ the scalar baseline (multiply-adds per second in a dependent chain).
+    pub per_baseline_op: f64,
+}
+
+/// The whole report.
+#[derive(Debug, Serialize)]
+pub struct BenchReport {
+    pub genus: u32,
+    pub vertices: usize,
+    /// Baselines, measured in this run.
+    pub copy_bandwidth_bytes_per_second: f64,
+    pub scalar_ops_per_second: f64,
+    pub figures: Vec<Figure>,
+}
+
+/// Best (smallest) time of `runs` calls of `f`, in seconds.
+fn best_of(runs: usize, mut f: impl FnMut()) -> f64 {
+    (0..runs)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn copy_bandwidth() -> f64 {
+    let words = 16 << 20;
+    let src: Vec<u64> = (0..words as u64).collect();
+    let mut dst = vec![0u64; words];
+    let t = best_of(3, || {
+        dst.copy_from_slice(black_box(&src));
+        black_box(&mut dst);
+    });
+    (2 * 8 * words) as f64 / t
+}
+
+fn scalar_ops() -> f64 {
+    let n = 20_000_000u64;
+    let t = best_of(3, || {
+        let mut x = 1.0f64;
+        for _ in 0..n {
+            x = black_box(x) * 0.999_999_9 + 1e-9;
+        }
+        black_box(x);
+    });
+    n as f64 / t
+}
+
+/// Measures chart location, tessellation, stencil building, re-embedding and a drag event for genus
+/// `genus` at about `vertices` vertices.
+pub fn run(
+    genus: u32,
+    vertices: usize,
+    progress: &dyn Fn(&str),
+) -> Result<BenchReport, anyhow::Error> {
+    progress("baselines");
+    let (bandwidth, scalar) = (copy_bandwidth(), scalar_ops());
+    let atlas = Atlas::new(genus)?;
+    let t = tessellation_size(genus, vertices);
+    let mut figures = Vec::new();
+    let mut add = |name: &str, per_second: f64, unit, bytes: Option<f64>| {
+        figures.push(Figure {
+            name: name.into(),
+            per_second,
+            unit,
+            fraction_of_copy_bandwidth: bytes.map(|b| per_second * b / bandwidth),
+            per_baseline_op: per_second / scalar,
+        })
+    };
+    progress("tessellation");
+    let mut tess = None;
+    let secs = best_of(3, || tess = Some(atlas.tessellate(t, t)));
+    let tess = tess.expect("ran")?;
+    add(
+        "tessellate",
+        tess.triangles.len() as f64 / secs,
+        "triangles",
+        None,
+    );
+    let pts: Vec<ChartPoint> = tess.vertices;
+    progress("point location");
+    let secs = best_of(3, || {
+        black_box(
+            pts.iter()
+                .map(|&p| atlas.locate_unchecked(p).representations().len())
+                .sum::<usize>(),
+        );
+    });
+    add(
+        "locate_chart_point",
+        pts.len() as f64 / secs,
+        "points",
+        None,
+    );
+    let layout = Layout::new(&atlas, SplineSettings::default())?;
+    let mut control: Vec<Point3> = (0..layout.control_count())
+        .map(|i| {
+            Point3::new(
+                (i as f64 * 0.37).sin(),
+                (i as f64 * 0.71).cos(),
+                (i as f64 * 0.13).sin(),
+            )
+        })
+        .collect();
+    progress("stencil build");
+    let mut stencil = Stencil::default();
+    let secs = best_of(2, || stencil = Stencil::build(&layout, &pts));
+    add("stencil_build", pts.len() as f64 / secs, "vertices", None);
+    progress("re-embedding");
+    let mut out = vec![Point3::zeros(); stencil.rows()];
+    let secs = best_of(5, || stencil.positions(black_box(&control), &mut out));
+    let bytes = 8.0 + 12.0 * stencil.nonzeros() as f64 / stencil.rows() as f64 + 24.0;
+    add("reembed", pts.len() as f64 / secs, "vertices", Some(bytes));
+    progress("drag events");
+    let index = stencil.column_index(layout.control_count());
+    let mut scratch = RefreshScratch::default();
+    let q = pts[pts.len() / 3];
+    let events = 20;
+    let secs = best_of(1, || {
+        for k in 0..events {
+            let target = out[pts.len() / 3] + Point3::new(1e-3 * k as f64, 0.0, 0.0);
+            if let Ok(edit) = solve(&layout, &control, &[Constraint { point: q, target }]) {
+                edit.apply(&mut control);
+                refresh(&stencil, &index, &edit, &control, &mut out, &mut scratch);
+            }
+        }
+    });
+    add("drag_event", f64::from(events) / secs, "events", None);
+    Ok(BenchReport {
+        genus,
+        vertices: pts.len(),
+        copy_bandwidth_bytes_per_second: bandwidth,
+        scalar_ops_per_second: scalar,
+        figures,
+    })
+}
+
+/// t_e = t_r = t giving about `vertices` vertices.
+fn tessellation_size(genus: u32, vertices: usize) -> u32 {
+    (1..=charts::MAX_RESOLUTION)
+        .find(|&t| charts::Tessellation::expected_vertices(genus, t, t) >= vertices as u64)
+        .unwrap_or(charts::MAX_RESOLUTION)
+}

@@ -1,0 +1,57 @@
+//! `ntori bench` prints well-formed JSON with positive, finite figures.
+
+use assert_cmd::Command;
+
+#[test]
+fn bench_prints_json_figures() {
+    let out = Command::cargo_bin("ntori")
+        .unwrap()
+        .args(["bench", "--quiet", "--vertices", "3000", "--genus", "3"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["copy_bandwidth_bytes_per_second"].as_f64().unwrap() > 1e8);
+    let figures = v["figures"].as_array().unwrap();
+    let names: Vec<&str> = figures
+        .iter()
+        .map(|f| f["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "tessellate",
+            "locate_chart_point",
+            "stencil_build",
+            "reembed",
+            "drag_event"
+        ]
+    );
+    for f in figures {
+        let rate = f["per_second"].as_f64().unwrap();
+        assert!(rate.is_finite() && rate > 0.0, "{f}");
+    }
+    let fraction = figures[3]["fraction_of_copy_bandwidth"].as_f64().unwrap();
+    assert!(
+        fraction > 0.0 && fraction < 5.0,
+        "re-embedding cannot beat memory by much: {fraction}"
+    );
+}
+
+#[test]
+fn bench_refuses_absurd_sizes() {
+    Command::cargo_bin("ntori")
+        .unwrap()
+        .args(["bench", "--vertices", "0"])
+        .assert()
+        .code(2);
+    Command::cargo_bin("ntori")
+        .unwrap()
+        .args(["bench", "--genus", "99", "--quiet"])
+        .assert()
+        .code(1);
+}
