@@ -20,6 +20,20 @@ struct Cli {
     command: Command,
 }
 
+/// The surface's genus, as every subcommand takes it.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct GenusArg {
+    /// Genus of the surface: 0 (sphere), 1 (torus), 2 … 64.
+    #[arg(
+        short,
+        long,
+        default_value_t = 2,
+        value_name = "N",
+        allow_negative_numbers = true
+    )]
+    genus: u32,
+}
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Show the chart structure for one genus, and check it.
@@ -47,15 +61,8 @@ enum Command {
     ///   ntori info --genus 1 --json      the flat torus, as JSON
     #[command(verbatim_doc_comment)]
     Info {
-        /// Genus of the surface: 0 (sphere), 1 (torus), 2 … 64.
-        #[arg(
-            short,
-            long,
-            default_value_t = 2,
-            value_name = "N",
-            allow_negative_numbers = true
-        )]
-        genus: u32,
+        #[command(flatten)]
+        genus: GenusArg,
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
@@ -83,15 +90,8 @@ enum Command {
     ///   ntori tessellate --genus 3 --te 1 --tr 1 --svg coarsest.svg   (the paper's figure 7)
     #[command(verbatim_doc_comment)]
     Tessellate {
-        /// Genus of the surface: 0 (sphere), 1 (torus), 2 … 64.
-        #[arg(
-            short,
-            long,
-            default_value_t = 2,
-            value_name = "N",
-            allow_negative_numbers = true
-        )]
-        genus: u32,
+        #[command(flatten)]
+        genus: GenusArg,
         /// Divisions of each square (and each arc).
         #[arg(
             long,
@@ -122,15 +122,8 @@ enum Command {
     ///
     /// For statistics and history use `cargo bench`; this is the quick look.
     Bench {
-        /// Genus of the surface.
-        #[arg(
-            short,
-            long,
-            default_value_t = 2,
-            value_name = "N",
-            allow_negative_numbers = true
-        )]
-        genus: u32,
+        #[command(flatten)]
+        genus: GenusArg,
         /// About how many vertices to measure with.
         #[arg(long, default_value_t = 100_000, value_name = "V",
               value_parser = clap::value_parser!(u64).range(10..=5_000_000))]
@@ -180,7 +173,7 @@ fn init_logging(verbose: u8) {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info {
-            genus,
+            genus: GenusArg { genus },
             json,
             points,
         } => {
@@ -200,12 +193,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             })
         }
         Command::Bench {
-            genus,
+            genus: GenusArg { genus },
             vertices,
             quiet,
         } => bench(genus, vertices, quiet),
         Command::Tessellate {
-            genus,
+            genus: GenusArg { genus },
             te,
             tr,
             json,

@@ -118,6 +118,25 @@ pub fn spread_points(atlas: &Atlas, count: usize) -> Vec<ModelPoint> {
     out
 }
 
+/// A point strictly inside chart `chart % count`'s domain from two numbers in [0, 1): the square
+/// uniformly, the disk uniformly by area. For property tests and benches.
+///
+/// ```
+/// let atlas = charts::Atlas::new(2).unwrap();
+/// let p = charts::check::chart_point_from_unit(&atlas, 7, 0.3, 0.9);
+/// assert!(atlas.locate(p).is_ok());
+/// ```
+pub fn chart_point_from_unit(atlas: &Atlas, chart: usize, u: f64, v: f64) -> ChartPoint {
+    let id = crate::ChartId((chart % atlas.charts().len()) as u32);
+    let w = match atlas.charts()[id.index()].domain() {
+        crate::Domain::Square => Complex64::new(u - 0.5, v - 0.5) * (1.0 - 1e-9),
+        crate::Domain::Disk => {
+            Complex64::from_polar(0.5 * u.sqrt() * (1.0 - 1e-9), std::f64::consts::TAU * v)
+        }
+    };
+    ChartPoint::new(id, w)
+}
+
 /// The R2 low-discrepancy sequence (Roberts), well spread in the unit square for any prefix.
 fn r2(i: usize) -> (f64, f64) {
     const G: f64 = 1.324_717_957_244_746; // the plastic number

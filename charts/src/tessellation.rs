@@ -234,10 +234,9 @@ impl Atlas {
                 triangle_edge_labels: Vec::new(),
             },
         };
-        if self.polygon().is_some() {
-            self.tessellate_polygon(&mut b)?;
-        } else {
-            self.tessellate_sphere(&mut b)?;
+        match self.polygon() {
+            Some(poly) => self.tessellate_polygon(poly, &mut b)?,
+            None => self.tessellate_sphere(&mut b)?,
         }
         Ok(b.t)
     }
@@ -245,12 +244,14 @@ impl Atlas {
     /// Half-size s of the tessellation squares: β = φ(−s + i s) in edge chart a₁.
     pub fn tessellation_square_half(&self) -> Option<f64> {
         let beta = self.polygon()?.constants().beta;
-        let chart = self
-            .charts()
-            .iter()
-            .find(|c| c.domain() == Domain::Square)?;
-        let w = chart.to_model().inverse().apply(beta);
-        Some(0.5 * (w.im - w.re))
+        Some(self.square_half(beta))
+    }
+
+    /// β = φ(−s + i s) in the first edge chart, solved for s.
+    fn square_half(&self, beta: Complex64) -> f64 {
+        let chart = self.charts().iter().find(|c| c.domain() == Domain::Square);
+        let w = chart.map_or(Complex64::ZERO, |c| c.to_model().inverse().apply(beta));
+        0.5 * (w.im - w.re)
     }
 
     fn tessellate_sphere(&self, b: &mut Builder) -> Result<(), ChartsError> {
@@ -270,9 +271,12 @@ impl Atlas {
         b.wheel(south, Region::InsideWheel, &equator, "southern cap")
     }
 
-    fn tessellate_polygon(&self, b: &mut Builder) -> Result<(), ChartsError> {
-        let poly = self.polygon().expect("polygon atlas");
-        let s = self.tessellation_square_half().expect("polygon atlas");
+    fn tessellate_polygon(
+        &self,
+        poly: &crate::Polygon,
+        b: &mut Builder,
+    ) -> Result<(), ChartsError> {
+        let s = self.square_half(poly.constants().beta);
         if !(s > 0.0 && s < 0.5) {
             return Err(ChartsError::InvalidTessellation(format!(
                 "the tessellation square (half-size {s}) does not fit in its edge chart"

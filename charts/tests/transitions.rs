@@ -17,17 +17,7 @@ fn atlas(genus: u32) -> &'static Atlas {
     ATLASES[genus as usize].get_or_init(|| Atlas::new(genus).expect("default atlas"))
 }
 
-/// A point strictly inside the chart's domain from two uniform numbers.
-fn chart_point(atlas: &Atlas, chart: usize, u: f64, v: f64) -> ChartPoint {
-    let id = ChartId((chart % atlas.charts().len()) as u32);
-    let w = match atlas.charts()[id.index()].domain() {
-        Domain::Square => Complex64::new(u - 0.5, v - 0.5) * (1.0 - 1e-9),
-        Domain::Disk => {
-            Complex64::from_polar(0.5 * u.sqrt() * (1.0 - 1e-9), std::f64::consts::TAU * v)
-        }
-    };
-    ChartPoint::new(id, w)
-}
+use charts::check::chart_point_from_unit as chart_point;
 
 fn check_point(genus: u32, p: ChartPoint) -> Result<(), TestCaseError> {
     let atlas = atlas(genus);

@@ -50,6 +50,18 @@ pub struct Jet {
 }
 
 impl Jet {
+    /// f(u)·g(v) from the values and first two derivatives of f and g.
+    fn tensor(f: [f64; 3], g: [f64; 3]) -> Jet {
+        Jet {
+            val: f[0] * g[0],
+            du: f[1] * g[0],
+            dv: f[0] * g[1],
+            duu: f[2] * g[0],
+            duv: f[1] * g[1],
+            dvv: f[0] * g[2],
+        }
+    }
+
     fn product(a: Jet, b: Jet) -> Jet {
         Jet {
             val: a.val * b.val,
@@ -187,14 +199,7 @@ impl<'a> Layout<'a> {
         match domain {
             Domain::Square => {
                 let (x, y) = (cardinal(d, w.re + 0.5), cardinal(d, w.im + 0.5));
-                Jet {
-                    val: x[0] * y[0],
-                    du: x[1] * y[0],
-                    dv: x[0] * y[1],
-                    duu: x[2] * y[0],
-                    duv: x[1] * y[1],
-                    dvv: x[0] * y[2],
-                }
+                Jet::tensor([x[0], x[1], x[2]], [y[0], y[1], y[2]])
             }
             Domain::Disk => {
                 let r = w.norm();
@@ -243,14 +248,7 @@ impl<'a> Layout<'a> {
             let (bu, bv) = (triples(&nu), triples(&nv));
             for (j, y) in bv.iter().enumerate() {
                 for (i, x) in bu.iter().enumerate() {
-                    let basis = Jet {
-                        val: x[0] * y[0],
-                        du: x[1] * y[0],
-                        dv: x[0] * y[1],
-                        duu: x[2] * y[0],
-                        duv: x[1] * y[1],
-                        dvv: x[0] * y[2],
-                    };
+                    let basis = Jet::tensor(*x, *y);
                     out.push(Weight {
                         control: self.control_index(rep.chart, fu + i, fv + j) as u32,
                         jet: Jet::product(raw, basis).through(d1, d2),

@@ -3,7 +3,7 @@
 
 use std::sync::OnceLock;
 
-use charts::{Atlas, ChartId, ChartPoint, Domain};
+use charts::{Atlas, ChartId, ChartPoint};
 use embedding::bspline::UniformBasis;
 use embedding::{Layout, Model, Point3, SplineSettings, Stencil};
 use nalgebra::{DMatrix, DVector};
@@ -15,16 +15,7 @@ fn atlas(genus: u32) -> &'static Atlas {
     ATLASES[genus as usize].get_or_init(|| Atlas::new(genus).unwrap())
 }
 
-fn chart_point(atlas: &Atlas, chart: usize, u: f64, v: f64) -> ChartPoint {
-    let id = ChartId((chart % atlas.charts().len()) as u32);
-    let w = match atlas.charts()[id.index()].domain() {
-        Domain::Square => Complex64::new(u - 0.5, v - 0.5) * (1.0 - 1e-9),
-        Domain::Disk => {
-            Complex64::from_polar(0.5 * u.sqrt() * (1.0 - 1e-9), std::f64::consts::TAU * v)
-        }
-    };
-    ChartPoint::new(id, w)
-}
+use charts::check::chart_point_from_unit as chart_point;
 
 /// Deterministic pseudo-random control points (each chart's patch differs, so blending matters).
 fn noisy_controls(layout: &Layout, seed: u64) -> Vec<Point3> {
