@@ -23,6 +23,7 @@
 
 pub mod bspline;
 pub mod edit;
+pub mod floater;
 pub mod model;
 pub mod stencil;
 pub mod surface;
@@ -58,6 +59,8 @@ pub enum EmbeddingError {
     BadTarget(usize),
     #[error("the edit's constraints could not be solved")]
     Unsolvable,
+    #[error("cannot parameterize the mesh: {0}")]
+    Parameterization(String),
     #[error(transparent)]
     Chart(#[from] charts::ChartsError),
 }
