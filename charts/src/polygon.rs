@@ -23,7 +23,7 @@ pub enum Geometry {
     Hyperbolic,
 }
 
-/// The paper's constants, re-derived (see the module docs of [`Polygon::hyperbolic`]).
+/// The paper's constants, re-derived from their definitions (closed forms in `Polygon::hyperbolic`).
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct PolygonConstants {
     /// ω = 2π/4n, the angle between neighbouring edge directions (and each corner's interior angle).
@@ -263,7 +263,7 @@ impl Polygon {
     }
 
     /// The product, over the walk around the vertex, of the maps onto the tiles crossed into:
-    /// cross[e₀]·cross[e₁]·…·cross[e₄ₙ₋₁]. It is the defining relation of the group, so it must be the
+    /// `cross[e₀]·cross[e₁]·…·cross[e₄ₙ₋₁]`. It is the defining relation of the group, so it must be the
     /// identity. Formed in double-double and rounded once; `naive` forms it in f64 instead (which
     /// loses ~12 digits at n = 64, the reason the atlas uses DD).
     pub fn vertex_composite(&self, naive: bool) -> crate::Lft {

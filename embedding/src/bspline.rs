@@ -52,7 +52,7 @@ impl UniformBasis {
     }
 
     /// The p + 1 basis functions that do not vanish at x (clamped into [−½, ½]) and their derivatives
-    /// up to order `derivs` (≤ p): returns (index of the first, table[d][j] = d-th derivative of basis
+    /// up to order `derivs` (≤ p): returns (index of the first, `table[d][j]` = d-th derivative of basis
     /// function first + j). The Cox–de Boor triangle and its derivative form (Piegl and Tiller's
     /// algorithm A2.3), on uniform knots.
     pub fn eval(&self, x: f64, derivs: usize) -> (usize, [[f64; MAX_DEGREE + 1]; 4]) {
