@@ -115,10 +115,12 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         svg: Option<std::path::PathBuf>,
     },
-    /// Measure throughput and print JSON: tessellation, point location, stencil building,
-    /// re-embedding (also as a fraction of memory copy bandwidth) and drag events. Baselines (copy
-    /// bandwidth, a chain of scalar multiply-adds) are measured in the same run, and every figure is
-    /// also given per baseline operation, since this machine is shared and noisy.
+    /// Measure throughput and print it as JSON.
+    ///
+    /// Figures for tessellation, point location, stencil building, re-embedding (also as a fraction
+    /// of memory copy bandwidth) and drag events. Baselines (copy bandwidth, a chain of scalar
+    /// multiply-adds) are measured in the same run, and every figure is also given per baseline
+    /// operation, since this machine is shared and noisy.
     ///
     /// For statistics and history use `cargo bench`; this is the quick look.
     Bench {
