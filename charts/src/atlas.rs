@@ -587,12 +587,9 @@ fn edge_meets_disk(poly: &Polygon, e: usize, c: Complex64, r: f64) -> bool {
             // the side facing the origin) use it, otherwise the nearer endpoint.
             let off = c - centre;
             let foot = centre + off * (radius / off.norm().max(1e-300));
-            let on_arc = (foot - centre).norm() > 0.0 && {
-                let ang = |z: Complex64| ((z - centre) / (-centre)).arg();
-                let (a0, a1) = (ang(p), ang(q));
-                let a = ang(foot);
-                a >= a0.min(a1) && a <= a0.max(a1)
-            };
+            let ang = |z: Complex64| ((z - centre) / (-centre)).arg();
+            let (a0, a1, a) = (ang(p), ang(q), ang(foot));
+            let on_arc = a >= a0.min(a1) && a <= a0.max(a1);
             let ends = (c - p).norm().min((c - q).norm());
             if on_arc {
                 (off.norm() - radius).abs().min(ends)

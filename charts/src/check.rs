@@ -114,7 +114,7 @@ pub fn spread_points(atlas: &Atlas, count: usize) -> Vec<ModelPoint> {
             }));
         }
     }
-    out.truncate(count.max(out.len().min(count)));
+    out.truncate(count);
     out
 }
 
