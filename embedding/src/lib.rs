@@ -23,7 +23,9 @@
 
 pub mod bspline;
 pub mod edit;
+pub mod fit;
 pub mod floater;
+pub mod holed;
 pub mod model;
 pub mod stencil;
 pub mod surface;

@@ -54,6 +54,14 @@ impl Model {
         }
     }
 
+    /// A model of `layout` with the given control points (in layout order).
+    pub fn from_points(layout: &Layout, points: &[Point3]) -> Model {
+        Model {
+            control_points: points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+            ..Model::constant(layout, Point3::zeros())
+        }
+    }
+
     /// The control points as vectors.
     pub fn points(&self) -> Vec<Point3> {
         self.control_points

@@ -1,0 +1,581 @@
+//! The initial surface (the paper's section 5.1): an n-holed mesh is cut along its canonical loops
+//! into a disk, the disk is flattened onto the fundamental polygon with Floater's mean value
+//! parameterization, and every chart's control points are fitted at once so that S(p_i) ≈ P_i at the
+//! surface point p_i of each mesh vertex.
+//!
+//! Floater's map is a bijection only onto a convex boundary. The hyperbolic polygon is concave in the
+//! Poincaré disk but convex in the Klein model (geodesics are chords there), so the disk is flattened
+//! in Klein coordinates and mapped to the Poincaré disk afterwards, vertex by vertex. The boundary is
+//! pinned at hyperbolic arc length along each side, so partner sides' vertices are images of each
+//! other under the side pairings (isometries preserve arc length) and the seams agree.
+//!
+//! Genus 0 needs no cut: the sphere is mapped to the Riemann sphere by stereographic projection.
+//!
+//! ```
+//! use embedding::fit::{FitSettings, initial_model};
+//! use embedding::SplineSettings;
+//!
+//! let fit = initial_model(2, 24, SplineSettings::default(), FitSettings::default())?;
+//! assert_eq!(fit.model.genus, 2);
+//! assert!(fit.rms_residual < 0.01 * fit.mesh_diagonal);
+//! # Ok::<(), embedding::EmbeddingError>(())
+//! ```
+
+use std::collections::HashMap;
+
+use charts::{Atlas, ChartId, ChartPoint, Geometry, ModelPoint, Polygon};
+use faer::Mat;
+use faer::prelude::*;
+use faer::sparse::{SparseColMat, Triplet};
+use num_complex::Complex64;
+
+use crate::holed::HoledMesh;
+use crate::model::Model;
+use crate::surface::{Layout, Point3, SplineSettings};
+use crate::{EmbeddingError, floater};
+
+/// The mesh cut open along its loops: a triangulated disk whose vertices are copies of mesh vertices.
+#[derive(Clone, Debug)]
+pub struct CutDisk {
+    /// The mesh vertex each disk vertex copies.
+    pub original: Vec<u32>,
+    pub triangles: Vec<[u32; 3]>,
+    /// The boundary, counter-clockwise (the disk on the left), as disk vertices.
+    pub boundary: Vec<u32>,
+    /// For each of the 4n boundary arcs in order: (first index in `boundary`, polygon side).
+    pub arcs: Vec<(usize, usize)>,
+}
+
+/// Every mesh vertex's surface point, and the flattened disk it came from.
+#[derive(Clone, Debug)]
+pub struct Parameterization {
+    /// One chart point per mesh vertex (in its deepest chart).
+    pub points: Vec<ChartPoint>,
+    /// The cut (absent for genus 0).
+    pub disk: Option<CutDisk>,
+    /// Positions of the disk's vertices in the plane where Floater's map was solved: the Klein model
+    /// for n ≥ 2, the square itself for the torus.
+    pub flat: Vec<[f64; 2]>,
+}
+
+/// The weight of the smoothness term of the fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitSettings {
+    /// λ in ‖A c − P‖²_W + λ · (N / R) · ‖D c‖²: N data rows (area-weighted, mean weight 1), R
+    /// second-difference rows (u, v and mixed differences of every chart's control grid). λ = 0 leaves
+    /// control points without data undetermined; larger values trade fidelity for fairness.
+    pub smoothness: f64,
+}
+
+impl Default for FitSettings {
+    fn default() -> Self {
+        FitSettings { smoothness: 1e-3 }
+    }
+}
+
+/// A fitted model and how well it fits.
+#[derive(Clone, Debug)]
+pub struct InitialFit {
+    pub model: Model,
+    pub mesh: HoledMesh,
+    pub parameterization: Parameterization,
+    /// Root mean square and largest distance |S(p_i) − P_i| over the mesh vertices.
+    pub rms_residual: f64,
+    pub max_residual: f64,
+    /// The input mesh's bounding-box diagonal (the model's size).
+    pub mesh_diagonal: f64,
+}
+
+/// The whole pipeline: mesh (at `resolution`), cut, flatten, fit.
+pub fn initial_model(
+    genus: u32,
+    resolution: usize,
+    settings: SplineSettings,
+    fit_settings: FitSettings,
+) -> Result<InitialFit, EmbeddingError> {
+    let atlas = Atlas::new(genus)?;
+    let layout = Layout::new(&atlas, settings)?;
+    let mesh = HoledMesh::new(genus, resolution)?;
+    let parameterization = parameterize(&atlas, &mesh)?;
+    let weights = vertex_areas(&mesh.positions, &mesh.triangles);
+    let control = fit(
+        &layout,
+        &parameterization.points,
+        &mesh.positions,
+        &weights,
+        fit_settings,
+    )?;
+    let model = Model::from_points(&layout, &control);
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for (p, target) in parameterization.points.iter().zip(&mesh.positions) {
+        let e = (layout.eval(&control, *p).pos - target).norm();
+        sum += e * e;
+        max = max.max(e);
+    }
+    Ok(InitialFit {
+        model,
+        rms_residual: (sum / mesh.positions.len() as f64).sqrt(),
+        max_residual: max,
+        mesh_diagonal: diagonal(&mesh.positions),
+        mesh,
+        parameterization,
+    })
+}
+
+/// The bounding-box diagonal of a point set.
+pub fn diagonal(points: &[Point3]) -> f64 {
+    let (mut lo, mut hi) = (
+        Point3::repeat(f64::INFINITY),
+        Point3::repeat(f64::NEG_INFINITY),
+    );
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    (hi - lo).norm()
+}
+
+/// A third of the area of the triangles around each vertex.
+pub fn vertex_areas(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<f64> {
+    let mut areas = vec![0.0; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|v| positions[v as usize]);
+        let third = (b - a).cross(&(c - a)).norm() / 6.0;
+        for v in t {
+            areas[*v as usize] += third;
+        }
+    }
+    areas
+}
+
+// ------------------------------------------------------------------------------------------ cut
+
+/// Cuts a closed mesh along its loops. Each vertex on a loop is split into one copy per wedge of
+/// triangles between consecutive loop edges around it (p₀: 4n copies; other loop vertices: two).
+pub fn cut(mesh: &HoledMesh) -> Result<CutDisk, EmbeddingError> {
+    let fail = |what: &str| EmbeddingError::Parameterization(what.to_string());
+    let n = mesh.positions.len();
+    let is_cut: std::collections::HashSet<(u32, u32)> = mesh
+        .loops
+        .iter()
+        .flat_map(|l| l.windows(2).map(|w| (w[0].min(w[1]), w[0].max(w[1]))))
+        .collect();
+    let cut_edge = |a: u32, b: u32| is_cut.contains(&(a.min(b), a.max(b)));
+    let mut by_edge: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * mesh.triangles.len());
+    let mut corners: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            if by_edge.insert((tri[k], tri[(k + 1) % 3]), t).is_some() {
+                return Err(fail("an edge is used twice in the same direction"));
+            }
+            corners[tri[k] as usize].push((t, k));
+        }
+    }
+    let mut copy = vec![[u32::MAX; 3]; mesh.triangles.len()];
+    let mut original = Vec::new();
+    for v in 0..n as u32 {
+        let fan = &corners[v as usize];
+        if fan.is_empty() {
+            return Err(fail("a mesh vertex belongs to no triangle"));
+        }
+        // Wedges start at a corner whose incoming edge {v, a} is a loop edge; a vertex off the loops
+        // is one wedge, started anywhere.
+        let tri = |t: usize| mesh.triangles[t];
+        let starts: Vec<(usize, usize)> = fan
+            .iter()
+            .copied()
+            .filter(|&(t, k)| cut_edge(v, tri(t)[(k + 1) % 3]))
+            .collect();
+        let starts = if starts.is_empty() {
+            vec![fan[0]]
+        } else {
+            starts
+        };
+        for (mut t, mut k) in starts {
+            let id = original.len() as u32;
+            original.push(v);
+            loop {
+                if copy[t][k] != u32::MAX {
+                    break; // came round the whole fan (a vertex off the loops)
+                }
+                copy[t][k] = id;
+                let b = tri(t)[(k + 2) % 3];
+                if cut_edge(v, b) {
+                    break;
+                }
+                t = *by_edge
+                    .get(&(v, b))
+                    .ok_or_else(|| fail("the mesh has a boundary"))?;
+                k = (0..3).find(|&k| tri(t)[k] == v).expect("v is a corner");
+            }
+        }
+    }
+    if copy.iter().flatten().any(|&c| c == u32::MAX) {
+        return Err(fail("the mesh is not a manifold at some vertex"));
+    }
+    let boundary = boundary_cycle(&copy, original[..].iter().position(|&o| o == mesh.base))?;
+    let arcs = label_arcs(mesh, &original, &boundary)?;
+    Ok(CutDisk {
+        original,
+        triangles: copy,
+        boundary,
+        arcs,
+    })
+}
+
+/// The boundary of a disk as one counter-clockwise cycle of vertices, from `start`.
+fn boundary_cycle(
+    triangles: &[[u32; 3]],
+    start: Option<usize>,
+) -> Result<Vec<u32>, EmbeddingError> {
+    let fail = |what: &str| EmbeddingError::Parameterization(what.to_string());
+    let edges: std::collections::HashSet<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    let mut next = HashMap::new();
+    for &(a, b) in &edges {
+        if !edges.contains(&(b, a)) && next.insert(a, b).is_some() {
+            return Err(fail(
+                "the cut mesh is not a disk (a boundary vertex repeats)",
+            ));
+        }
+    }
+    let start = start.ok_or_else(|| fail("the base vertex is not on the cut"))? as u32;
+    let mut cycle = vec![start];
+    let mut v = *next
+        .get(&start)
+        .ok_or_else(|| fail("the base vertex is not on the cut"))?;
+    while v != start {
+        cycle.push(v);
+        v = *next
+            .get(&v)
+            .ok_or_else(|| fail("the cut's boundary is not closed"))?;
+        if cycle.len() > next.len() {
+            return Err(fail("the cut's boundary is not one cycle"));
+        }
+    }
+    if cycle.len() != next.len() {
+        return Err(fail(
+            "the cut leaves more than one boundary: it is not a disk",
+        ));
+    }
+    Ok(cycle)
+}
+
+/// Splits the boundary at the copies of p₀ into 4n arcs and matches them to polygon sides: arcs that
+/// run along the same loop must land on partner sides (4k + t ↔ 4k + t + 2).
+fn label_arcs(
+    mesh: &HoledMesh,
+    original: &[u32],
+    boundary: &[u32],
+) -> Result<Vec<(usize, usize)>, EmbeddingError> {
+    let fail = |what: String| EmbeddingError::Parameterization(what);
+    let mut loop_of = HashMap::new();
+    for (l, path) in mesh.loops.iter().enumerate() {
+        for w in path.windows(2) {
+            loop_of.insert((w[0].min(w[1]), w[0].max(w[1])), l);
+        }
+    }
+    let starts: Vec<usize> = (0..boundary.len())
+        .filter(|&i| original[boundary[i] as usize] == mesh.base)
+        .collect();
+    let sides = 4 * mesh.genus as usize;
+    if starts.len() != sides {
+        return Err(fail(format!(
+            "the cut has {} corners, the polygon {sides}",
+            starts.len()
+        )));
+    }
+    let loops: Vec<usize> = starts
+        .iter()
+        .map(|&i| {
+            let (a, b) = (
+                original[boundary[i] as usize],
+                original[boundary[(i + 1) % boundary.len()] as usize],
+            );
+            loop_of[&(a.min(b), a.max(b))]
+        })
+        .collect();
+    let partner = |e: usize| 4 * (e / 4) + (e % 4 + 2) % 4;
+    let shift = (0..sides)
+        .find(|&s| {
+            (0..sides).all(|i| loops[i] == loops[(partner((i + s) % sides) + sides - s) % sides])
+        })
+        .ok_or_else(|| fail("the loops do not read a1 b1 a1⁻¹ b1⁻¹ … around the cut".into()))?;
+    Ok(starts
+        .iter()
+        .enumerate()
+        .map(|(i, &start)| (start, (i + shift) % sides))
+        .collect())
+}
+
+// ---------------------------------------------------------------------------------- flattening
+
+/// Every mesh vertex's surface point: cut, pin the boundary to the polygon, Floater, locate.
+pub fn parameterize(atlas: &Atlas, mesh: &HoledMesh) -> Result<Parameterization, EmbeddingError> {
+    if mesh.genus != atlas.genus() {
+        return Err(EmbeddingError::Mismatch);
+    }
+    match atlas.polygon() {
+        None => Ok(stereographic(atlas, mesh)),
+        Some(polygon) => flatten(atlas, polygon, mesh),
+    }
+}
+
+/// Genus 0: ζ = (x + iy)/(R + z) on the round sphere, north cap around ζ = 0, south around ∞.
+fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
+    let (north, south) = (&atlas.charts()[0], &atlas.charts()[1]);
+    let points = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let r = p.norm();
+            let xy = Complex64::new(p.x, p.y);
+            if p.z >= 0.0 {
+                ChartPoint::new(north.id(), xy / ((r + p.z) * north.scale()))
+            } else {
+                // 1/(λζ) = (x − iy)/(λ(R − z)): finite at the south pole.
+                ChartPoint::new(south.id(), xy.conj() / ((r - p.z) * south.scale()))
+            }
+        })
+        .collect();
+    Parameterization {
+        points,
+        disk: None,
+        flat: Vec::new(),
+    }
+}
+
+fn flatten(
+    atlas: &Atlas,
+    polygon: &Polygon,
+    mesh: &HoledMesh,
+) -> Result<Parameterization, EmbeddingError> {
+    let disk = cut(mesh)?;
+    let hyperbolic = polygon.geometry() == Geometry::Hyperbolic;
+    let pins = pin_boundary(polygon, mesh, &disk);
+    let positions: Vec<Point3> = disk
+        .original
+        .iter()
+        .map(|&o| mesh.positions[o as usize])
+        .collect();
+    let pins_flat: Vec<(u32, [f64; 2])> = pins
+        .iter()
+        .map(|&(v, w)| {
+            let k = if hyperbolic { poincare_to_klein(w) } else { w };
+            (v, [k.re, k.im])
+        })
+        .collect();
+    let flat = floater::parameterize(&positions, &disk.triangles, &pins_flat)?;
+    let mut points = vec![None; mesh.positions.len()];
+    for (c, &o) in disk.original.iter().enumerate() {
+        if points[o as usize].is_some() {
+            continue;
+        }
+        let k = Complex64::new(flat[c][0], flat[c][1]);
+        let w = if hyperbolic { klein_to_poincare(k) } else { k };
+        points[o as usize] = Some(deepest(atlas, ModelPoint(w))?);
+    }
+    Ok(Parameterization {
+        points: points
+            .into_iter()
+            .map(|p| p.expect("every vertex has a copy"))
+            .collect(),
+        disk: Some(disk),
+        flat,
+    })
+}
+
+/// The representation of a model point that lies deepest inside its chart.
+fn deepest(atlas: &Atlas, z: ModelPoint) -> Result<ChartPoint, EmbeddingError> {
+    let m = atlas.locate_model(z);
+    m.representations()
+        .iter()
+        .copied()
+        .max_by(|a, b| {
+            let depth = |p: &ChartPoint| atlas.charts()[p.chart.index()].domain().margin(p.coords);
+            depth(a).total_cmp(&depth(b))
+        })
+        .ok_or_else(|| {
+            EmbeddingError::Parameterization(format!("the model point {} lies in no chart", z.0))
+        })
+}
+
+/// Boundary pins in the model (Poincaré disk or square): each arc's vertices at the fraction of their
+/// loop's 3D arc length, measured along the side by hyperbolic (or Euclidean) length.
+fn pin_boundary(polygon: &Polygon, mesh: &HoledMesh, disk: &CutDisk) -> Vec<(u32, Complex64)> {
+    let fractions = loop_fractions(mesh);
+    let mut pins = Vec::with_capacity(disk.boundary.len());
+    let len = disk.boundary.len();
+    for (a, &(start, side)) in disk.arcs.iter().enumerate() {
+        let end = disk.arcs.get(a + 1).map_or(len, |next| next.0);
+        let (c0, c1) = polygon.edge_corners(side);
+        let (p, q) = (polygon.corners()[c0], polygon.corners()[c1]);
+        let first = disk.original[disk.boundary[start] as usize];
+        let second = disk.original[disk.boundary[(start + 1) % len] as usize];
+        for i in start..end {
+            let v = disk.boundary[i];
+            let t = if i == start {
+                0.0
+            } else {
+                let (f, forward) = fractions[&(disk.original[v as usize], first, second)];
+                if forward { f } else { 1.0 - f }
+            };
+            pins.push((v, along_side(polygon.geometry(), p, q, t)));
+        }
+    }
+    pins
+}
+
+/// For each loop vertex v (other than p₀), keyed by (v, first, second) where (first, second) is the
+/// loop's first edge read in either direction: its arc-length fraction along the loop and whether
+/// that key's direction is the loop's own.
+fn loop_fractions(mesh: &HoledMesh) -> HashMap<(u32, u32, u32), (f64, bool)> {
+    let mut out = HashMap::new();
+    for path in &mesh.loops {
+        let lengths: Vec<f64> = path
+            .windows(2)
+            .map(|w| (mesh.positions[w[1] as usize] - mesh.positions[w[0] as usize]).norm())
+            .collect();
+        let total: f64 = lengths.iter().sum();
+        let (m, base) = (path.len() - 1, path[0]);
+        let mut s = 0.0;
+        for i in 1..m {
+            s += lengths[i - 1];
+            out.insert((path[i], base, path[1]), (s / total, true));
+            out.insert((path[i], base, path[m - 1]), (s / total, false));
+        }
+    }
+    out
+}
+
+/// The point at fraction t of the side from corner p to corner q, by hyperbolic length in the
+/// Poincaré disk (through the isometry taking p to 0), by length in the plane.
+fn along_side(geometry: Geometry, p: Complex64, q: Complex64, t: f64) -> Complex64 {
+    match geometry {
+        Geometry::Hyperbolic => {
+            let to_origin = |z: Complex64| (z - p) / (Complex64::ONE - p.conj() * z);
+            let back = |w: Complex64| (w + p) / (Complex64::ONE + p.conj() * w);
+            let q0 = to_origin(q);
+            let d = q0.norm().atanh();
+            back(q0 / q0.norm() * (t * d).tanh())
+        }
+        _ => p + (q - p) * t,
+    }
+}
+
+/// Poincaré disk → Klein disk: k = 2w / (1 + |w|²).
+pub fn poincare_to_klein(w: Complex64) -> Complex64 {
+    w * (2.0 / (1.0 + w.norm_sqr()))
+}
+
+/// Klein disk → Poincaré disk: w = k / (1 + √(1 − |k|²)).
+pub fn klein_to_poincare(k: Complex64) -> Complex64 {
+    k / (1.0 + (1.0 - k.norm_sqr()).max(0.0).sqrt())
+}
+
+// ------------------------------------------------------------------------------------------ fit
+
+/// Least-squares control points: Σ_i w_i |S(p_i) − P_i|² + smoothness, solved at once for every
+/// chart by a sparse QR factorisation (the three coordinates share it). `weights` are per-point
+/// weights (e.g. vertex areas; normalised here to mean 1).
+pub fn fit(
+    layout: &Layout,
+    points: &[ChartPoint],
+    targets: &[Point3],
+    weights: &[f64],
+    settings: FitSettings,
+) -> Result<Vec<Point3>, EmbeddingError> {
+    if points.len() != targets.len() || points.len() != weights.len() || points.is_empty() {
+        return Err(EmbeddingError::Parameterization(
+            "the fit needs one target and weight per surface point".into(),
+        ));
+    }
+    if !(settings.smoothness.is_finite() && settings.smoothness > 0.0) {
+        return Err(EmbeddingError::Parameterization(format!(
+            "the smoothness weight must be a positive number, got {}",
+            settings.smoothness
+        )));
+    }
+    let mean_weight = weights.iter().sum::<f64>() / weights.len() as f64;
+    let mut triplets = Vec::new();
+    let mut row_weights = Vec::new();
+    for (r, p) in points.iter().enumerate() {
+        let scale = (weights[r] / mean_weight).sqrt();
+        row_weights.clear();
+        layout.weights(*p, &mut row_weights);
+        for w in &row_weights {
+            triplets.push(Triplet::new(r, w.control as usize, scale * w.jet.val));
+        }
+    }
+    let data_rows = points.len();
+    let smooth = smoothness_rows(layout);
+    let reg_rows = smooth.len();
+    let root = (settings.smoothness * data_rows as f64 / reg_rows as f64).sqrt();
+    for (k, row) in smooth.iter().enumerate() {
+        for &(c, v) in row {
+            triplets.push(Triplet::new(data_rows + k, c, root * v));
+        }
+    }
+    let (rows, cols) = (data_rows + reg_rows, layout.control_count());
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, &triplets)
+        .map_err(|e| EmbeddingError::Parameterization(format!("{e:?}")))?;
+    let mut rhs = Mat::<f64>::zeros(rows, 3);
+    for (r, t) in targets.iter().enumerate() {
+        let scale = (weights[r] / mean_weight).sqrt();
+        for d in 0..3 {
+            rhs[(r, d)] = scale * t[d];
+        }
+    }
+    let qr = a
+        .sp_qr()
+        .map_err(|e| EmbeddingError::Parameterization(format!("the fit's QR failed: {e:?}")))?;
+    let x = qr.solve_lstsq(&rhs);
+    let control: Vec<Point3> = (0..cols)
+        .map(|c| Point3::new(x[(c, 0)], x[(c, 1)], x[(c, 2)]))
+        .collect();
+    if control.iter().any(|c| !c.iter().all(|v| v.is_finite())) {
+        return Err(EmbeddingError::Unsolvable);
+    }
+    Ok(control)
+}
+
+/// Second differences of every chart's control grid: along u, along v, and the mixed difference
+/// (scaled by √2, so the sum of squares is the discrete thin-plate energy).
+fn smoothness_rows(layout: &Layout) -> Vec<Vec<(usize, f64)>> {
+    let g = layout.settings().grid;
+    let mut rows = Vec::new();
+    for chart in layout.atlas().charts() {
+        let id: ChartId = chart.id();
+        let at = |i: usize, j: usize| layout.control_index(id, i, j);
+        for j in 0..g {
+            for i in 0..g {
+                if i + 2 < g {
+                    rows.push(vec![
+                        (at(i, j), 1.0),
+                        (at(i + 1, j), -2.0),
+                        (at(i + 2, j), 1.0),
+                    ]);
+                }
+                if j + 2 < g {
+                    rows.push(vec![
+                        (at(i, j), 1.0),
+                        (at(i, j + 1), -2.0),
+                        (at(i, j + 2), 1.0),
+                    ]);
+                }
+                if i + 1 < g && j + 1 < g {
+                    let s = std::f64::consts::SQRT_2;
+                    rows.push(vec![
+                        (at(i, j), s),
+                        (at(i + 1, j), -s),
+                        (at(i, j + 1), -s),
+                        (at(i + 1, j + 1), s),
+                    ]);
+                }
+            }
+        }
+    }
+    rows
+}

@@ -1,0 +1,589 @@
+//! Well-shaped genus-n triangle meshes with their canonical loops known by construction: the input of
+//! the initial fit (the paper's section 5.1 and figure 6).
+//!
+//! The surface is the boundary of a thickened plate with n holes, its rims rounded: a *plan* region
+//! Ω (a disk with n round holes) is meshed once in the plane, then lifted twice, to the top and to the
+//! bottom; a plan point at distance d < W from a boundary circle is folded over a quarter ellipse, so
+//! the two lifts meet smoothly (G¹) along the circles. With one hole and W = T = half the annulus width
+//! this is the round torus; with no hole and W = T = R it is the round sphere.
+//!
+//! The 2n loops are drawn in the plan before meshing (they are constraint edges of the triangulation,
+//! so they are edge paths of the mesh) and all pass through one base vertex p₀ on the top face:
+//! - a_k, a "petal" on the top face from p₀ around hole k and back;
+//! - b_k, from p₀ inside petal k to the rim of hole k, through the hole to the bottom face, along the
+//!   bottom to the outer rim, over it to the top, and back to p₀ in the gap after petal k.
+//!
+//! Around p₀ the four ends of handle k come in the order a_k out, b_k out, a_k in, b_k in, and the
+//! handles follow each other: cutting along the loops leaves one disk whose boundary reads
+//! a₁ b₁ a₁⁻¹ b₁⁻¹ … a_n b_n a_n⁻¹ b_n⁻¹ (checked, not assumed, by [`crate::fit`]).
+//!
+//! ```
+//! let mesh = embedding::holed::HoledMesh::new(2, 24)?;
+//! let (v, f) = (mesh.positions.len() as i64, mesh.triangles.len() as i64);
+//! assert_eq!(v - f / 2, 2 - 2 * 2); // χ = V − E + F with E = 3F/2
+//! assert_eq!(mesh.loops.len(), 4);
+//! # Ok::<(), embedding::EmbeddingError>(())
+//! ```
+
+use std::collections::HashMap;
+use std::f64::consts::{PI, TAU};
+
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+
+use crate::EmbeddingError;
+use crate::surface::Point3;
+
+/// Largest genus the generator builds (the atlas's limit).
+pub const MAX_GENUS: u32 = charts::MAX_GENUS;
+
+/// A closed genus-n triangle mesh with a canonical system of loops through one base vertex.
+#[derive(Clone, Debug)]
+pub struct HoledMesh {
+    pub genus: u32,
+    pub positions: Vec<Point3>,
+    /// Counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// a₁, b₁, a₂, b₂, …: closed vertex paths starting and ending at `base` (so the first and last
+    /// entries are `base`); consecutive entries are joined by a mesh edge. Empty for genus 0.
+    pub loops: Vec<Vec<u32>>,
+    pub base: u32,
+    /// Half the plate's thickness: the plate lies in |z| ≤ `thickness`.
+    pub thickness: f64,
+}
+
+/// A point of the plan (the plate seen from above).
+type P2 = [f64; 2];
+
+fn polar(centre: P2, radius: f64, angle: f64) -> P2 {
+    [
+        centre[0] + radius * angle.cos(),
+        centre[1] + radius * angle.sin(),
+    ]
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Circle {
+    centre: P2,
+    radius: f64,
+    /// The region lies outside the circle (a hole) or inside it (the outer rim).
+    hole: bool,
+}
+
+impl Circle {
+    /// Distance from `q` to the circle, positive on the region's side.
+    fn depth(&self, q: P2) -> f64 {
+        let r = (q[0] - self.centre[0]).hypot(q[1] - self.centre[1]);
+        if self.hole {
+            r - self.radius
+        } else {
+            self.radius - r
+        }
+    }
+}
+
+/// Which lift of the plan a path runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    Top,
+    Bottom,
+}
+
+/// The plan: region, rim shape, base point and the loops as polylines of key points.
+struct Plan {
+    circles: Vec<Circle>,
+    /// Width W of the rounded band (in the plan) and half-thickness T of the plate.
+    band: f64,
+    thickness: f64,
+    base: P2,
+    /// Per loop: pieces (side, polyline). Consecutive pieces share their end points.
+    loops: Vec<Vec<(Side, Vec<P2>)>>,
+    /// The boundary circles as closed polylines through the points where loops cross them.
+    boundary: Vec<(Circle, Vec<P2>)>,
+}
+
+/// Points from `a` to `b` (both included) no more than `h` apart. The interior points are computed
+/// from the pair in a canonical order, so the same segment requested backwards gives the same bits —
+/// segments shared by two loops then meet in shared vertices.
+fn segment(a: P2, b: P2, h: f64) -> Vec<P2> {
+    let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+    let m = (len / h).ceil().max(1.0) as usize;
+    let (p, q, flip) = if a <= b { (a, b, false) } else { (b, a, true) };
+    let mut pts: Vec<P2> = (0..=m)
+        .map(|i| match i {
+            0 => p,
+            i if i == m => q,
+            _ => {
+                let t = i as f64 / m as f64;
+                [p[0] + (q[0] - p[0]) * t, p[1] + (q[1] - p[1]) * t]
+            }
+        })
+        .collect();
+    if flip {
+        pts.reverse();
+    }
+    pts
+}
+
+/// Points along the arc of `c` from angle `t0` to `t1` (either direction), endpoints exactly `a`, `b`.
+fn arc(centre: P2, radius: f64, (t0, a): (f64, P2), (t1, b): (f64, P2), h: f64) -> Vec<P2> {
+    let m = ((t1 - t0).abs() * radius / h).ceil().max(1.0) as usize;
+    (0..=m)
+        .map(|i| match i {
+            0 => a,
+            i if i == m => b,
+            _ => polar(centre, radius, t0 + (t1 - t0) * i as f64 / m as f64),
+        })
+        .collect()
+}
+
+/// Joins polylines that share end points.
+fn chain(parts: &[Vec<P2>]) -> Vec<P2> {
+    let mut out: Vec<P2> = Vec::new();
+    for part in parts {
+        let skip = usize::from(out.last().is_some_and(|l| *l == part[0]));
+        out.extend_from_slice(&part[skip..]);
+    }
+    out
+}
+
+/// A full circle through the given marks (sorted by angle), closed (first point repeated last).
+fn circle_through(c: Circle, marks: &[(f64, P2)], h: f64) -> Vec<P2> {
+    let mut marks = marks.to_vec();
+    if marks.is_empty() {
+        marks.push((0.0, polar(c.centre, c.radius, 0.0)));
+    }
+    marks.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let first = marks[0];
+    let mut parts = Vec::new();
+    for (k, &m) in marks.iter().enumerate() {
+        let next = marks
+            .get(k + 1)
+            .copied()
+            .unwrap_or((first.0 + TAU, first.1));
+        parts.push(arc(c.centre, c.radius, m, next, h));
+    }
+    chain(&parts)
+}
+
+impl Plan {
+    /// Genus 0: the round sphere of radius 1 (every plan point is in the band).
+    fn sphere(h: f64) -> Plan {
+        let equator = Circle {
+            centre: [0.0, 0.0],
+            radius: 1.0,
+            hole: false,
+        };
+        Plan {
+            circles: vec![equator],
+            band: 1.0,
+            thickness: 1.0,
+            base: [0.0, 0.0],
+            loops: Vec::new(),
+            boundary: vec![(equator, circle_through(equator, &[], h))],
+        }
+    }
+
+    /// Genus 1: the round torus with radii 2 and 1; p₀ on top of the tube, a₁ the top circle, b₁ the
+    /// meridian through p₀.
+    fn torus(h: f64) -> Plan {
+        let hole = Circle {
+            centre: [0.0, 0.0],
+            radius: 1.0,
+            hole: true,
+        };
+        let outer = Circle {
+            centre: [0.0, 0.0],
+            radius: 3.0,
+            hole: false,
+        };
+        let base = [-2.0, 0.0];
+        let (near, far) = ([-1.0, 0.0], [-3.0, 0.0]);
+        let a = arc([0.0, 0.0], 2.0, (PI, base), (-PI, base), h);
+        let b = vec![
+            (Side::Top, segment(base, near, h)),
+            (
+                Side::Bottom,
+                chain(&[segment(near, base, h), segment(base, far, h)]),
+            ),
+            (Side::Top, segment(far, base, h)),
+        ];
+        Plan {
+            boundary: vec![
+                (hole, circle_through(hole, &[(PI, near)], h)),
+                (outer, circle_through(outer, &[(PI, far)], h)),
+            ],
+            circles: vec![hole, outer],
+            band: 1.0,
+            thickness: 1.0,
+            base,
+            loops: vec![vec![(Side::Top, a)], b],
+        }
+    }
+
+    /// Genus n ≥ 2: a round plate with n holes on a ring around p₀ (the centre).
+    fn plate(n: u32, h: f64) -> Plan {
+        let o = [0.0, 0.0];
+        let (r_hole, band) = (0.5, 0.35);
+        let sector = PI / f64::from(n);
+        // The 4n loop ends leave p₀ at equal angles δ = 2π/4n (a_k out at θ_k − δ, b_k out at θ_k,
+        // a_k in at θ_k + δ, b_k in at θ_k + 2δ), so the wedges between them are congruent, like the
+        // polygon's corners they flatten into. The ring is wide enough for the petal's rays to clear
+        // their hole by 0.15 and for the bands of neighbouring holes not to meet.
+        let delta = 0.5 * sector;
+        let ring = (1.3f64)
+            .max((r_hole + 0.15) / delta.sin())
+            .max((r_hole + 0.55) / sector.sin());
+        let r_outer = ring + r_hole + 0.9;
+        let r_petal = ring + r_hole + 0.45;
+        let r_cross = 0.5 * (ring - r_hole);
+        let outer = Circle {
+            centre: o,
+            radius: r_outer,
+            hole: false,
+        };
+        let mut circles = Vec::new();
+        let mut boundary = Vec::new();
+        let mut loops = Vec::new();
+        let mut outer_marks = Vec::new();
+        for k in 0..n {
+            let theta = 2.0 * sector * f64::from(k);
+            let gap = theta + sector;
+            let hole = Circle {
+                centre: polar(o, ring, theta),
+                radius: r_hole,
+                hole: true,
+            };
+            let near = polar(hole.centre, r_hole, theta + PI);
+            let rim = polar(o, r_outer, gap);
+            outer_marks.push((gap, rim));
+            let (x, y, z) = (
+                polar(o, r_cross, theta),
+                polar(o, r_cross, theta + delta),
+                polar(o, r_cross, gap),
+            );
+            let (pa, pb) = (
+                polar(o, r_petal, theta - delta),
+                polar(o, r_petal, theta + delta),
+            );
+            let petal = chain(&[
+                segment(o, pa, h),
+                arc(o, r_petal, (theta - delta, pa), (theta + delta, pb), h),
+                segment(pb, y, h),
+                segment(y, o, h),
+            ]);
+            let b = vec![
+                (Side::Top, chain(&[segment(o, x, h), segment(x, near, h)])),
+                (
+                    Side::Bottom,
+                    chain(&[
+                        segment(near, x, h),
+                        arc(o, r_cross, (theta, x), (theta + delta, y), h),
+                        arc(o, r_cross, (theta + delta, y), (gap, z), h),
+                        segment(z, rim, h),
+                    ]),
+                ),
+                (Side::Top, chain(&[segment(rim, z, h), segment(z, o, h)])),
+            ];
+            loops.push(vec![(Side::Top, petal)]);
+            loops.push(b);
+            boundary.push((hole, circle_through(hole, &[(theta + PI, near)], h)));
+            circles.push(hole);
+        }
+        boundary.push((outer, circle_through(outer, &outer_marks, h)));
+        circles.push(outer);
+        Plan {
+            circles,
+            band,
+            thickness: band,
+            base: o,
+            loops,
+            boundary,
+        }
+    }
+
+    /// The typical spacing of boundary points for a resolution (points around a hole).
+    fn spacing(genus: u32, resolution: usize) -> f64 {
+        let radius = match genus {
+            0 | 1 => 1.0,
+            _ => 0.5,
+        };
+        TAU * radius / resolution as f64
+    }
+
+    /// The lift of a plan point to the top (or, mirrored, bottom) face: flat where it lies deeper than
+    /// the band, folded over a quarter ellipse (semi-axes W in the plan, T in height) near a rim.
+    fn lift(&self, q: P2, side: Side) -> Point3 {
+        let nearest = self
+            .circles
+            .iter()
+            .min_by(|a, b| a.depth(q).total_cmp(&b.depth(q)))
+            .expect("a plan has at least one circle");
+        let d = nearest.depth(q).max(0.0);
+        let (x, y, z) = if d >= self.band {
+            (q[0], q[1], self.thickness)
+        } else {
+            // φ = 0 at the inner edge of the band (flat), π/2 on the circle (vertical).
+            let phi = 0.5 * PI * (1.0 - d / self.band);
+            let (dx, dy) = (q[0] - nearest.centre[0], q[1] - nearest.centre[1]);
+            let r = dx.hypot(dy);
+            // Unit vector pointing out of the region, across the circle.
+            let (ux, uy) = if r > 0.0 {
+                (dx / r, dy / r)
+            } else {
+                (1.0, 0.0)
+            };
+            let out = if nearest.hole { -1.0 } else { 1.0 };
+            // The band's inner edge, then out by W·sin φ.
+            let reach = self.band * phi.sin() - (self.band - d);
+            (
+                q[0] + out * ux * reach,
+                q[1] + out * uy * reach,
+                self.thickness * phi.cos(),
+            )
+        };
+        match side {
+            Side::Top => Point3::new(x, y, z),
+            Side::Bottom => Point3::new(x, y, -z),
+        }
+    }
+}
+
+impl HoledMesh {
+    /// The genus-n mesh at `resolution` (boundary points around a hole, or around the sphere's equator;
+    /// 8 to 1024). Triangles have angles ≥ 20° in the plan; the rounded rims stretch them by up to π/2
+    /// across the band.
+    pub fn new(genus: u32, resolution: usize) -> Result<HoledMesh, EmbeddingError> {
+        if genus > MAX_GENUS {
+            return Err(EmbeddingError::Chart(
+                charts::ChartsError::UnsupportedGenus {
+                    genus,
+                    max: MAX_GENUS,
+                },
+            ));
+        }
+        if !(8..=1024).contains(&resolution) {
+            return Err(EmbeddingError::Parameterization(format!(
+                "mesh resolution {resolution} is outside 8 to 1024"
+            )));
+        }
+        let h = Plan::spacing(genus, resolution);
+        let plan = match genus {
+            0 => Plan::sphere(h),
+            1 => Plan::torus(h),
+            n => Plan::plate(n, h),
+        };
+        build(&plan, h, genus)
+    }
+}
+
+/// Exact-bits key of a plan point.
+fn key(p: P2) -> (u64, u64) {
+    (p[0].to_bits(), p[1].to_bits())
+}
+
+/// Meshes the plan in the plane (constrained Delaunay, refined) and lifts it.
+fn build(plan: &Plan, h: f64, genus: u32) -> Result<HoledMesh, EmbeddingError> {
+    let fail = |what: String| EmbeddingError::Parameterization(what);
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+    let mut handles = HashMap::new();
+    let mut insert = |cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>, p: P2| {
+        if let Some(&v) = handles.get(&key(p)) {
+            return Ok(v);
+        }
+        let v = cdt
+            .insert(Point2::new(p[0], p[1]))
+            .map_err(|e| fail(format!("plan point {p:?}: {e:?}")))?;
+        handles.insert(key(p), v);
+        Ok::<_, EmbeddingError>(v)
+    };
+    let mut polylines: Vec<&Vec<P2>> = plan.boundary.iter().map(|(_, line)| line).collect();
+    for pieces in &plan.loops {
+        polylines.extend(pieces.iter().map(|(_, line)| line));
+    }
+    // Points first, then the constraints between consecutive points.
+    let mut lines = Vec::new();
+    for line in &polylines {
+        let vs = line
+            .iter()
+            .map(|&p| insert(&mut cdt, p))
+            .collect::<Result<Vec<_>, _>>()?;
+        lines.push(vs);
+    }
+    for vs in &lines {
+        for w in vs.windows(2) {
+            if w[0] != w[1] && cdt.can_add_constraint(w[0], w[1]) {
+                cdt.add_constraint(w[0], w[1]);
+            } else if w[0] != w[1] && !cdt.exists_constraint(w[0], w[1]) {
+                return Err(fail("two loops of the plan cross".into()));
+            }
+        }
+    }
+    split_dividing_edges(plan, &mut cdt, &handles)?;
+    let area = 3f64.sqrt() / 4.0 * h * h;
+    let result = cdt.refine(
+        spade::RefinementParameters::new()
+            .keep_constraint_edges()
+            .with_angle_limit(spade::AngleLimit::from_deg(20.0))
+            .with_max_allowed_area(1.5 * area)
+            .with_max_additional_vertices(20_000_000),
+    );
+    if !result.refinement_complete {
+        return Err(fail("the plan could not be meshed finely enough".into()));
+    }
+    // Refinement may have flipped edges into dividing position again.
+    split_dividing_edges(plan, &mut cdt, &handles)?;
+    lift(plan, &cdt, &handles, genus)
+}
+
+/// Splits every edge that is not on a loop but joins two vertices on loops of the same lift. Cut
+/// open, such an edge would join two boundary points of the disk through its interior, and Floater's
+/// map would flatten its triangles onto a side (Floater's theorem needs no such "dividing" edges).
+fn split_dividing_edges(
+    plan: &Plan,
+    cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
+    handles: &HashMap<(u64, u64), spade::handles::FixedVertexHandle>,
+) -> Result<(), EmbeddingError> {
+    use std::collections::HashSet;
+    let mut on_loop = [HashSet::new(), HashSet::new()];
+    let mut loop_edges = [HashSet::new(), HashSet::new()];
+    for pieces in &plan.loops {
+        for (side, line) in pieces {
+            let s = usize::from(*side == Side::Bottom);
+            let ids: Vec<usize> = line.iter().map(|&p| handles[&key(p)].index()).collect();
+            on_loop[s].extend(ids.iter().copied());
+            loop_edges[s].extend(ids.windows(2).map(|w| (w[0].min(w[1]), w[0].max(w[1]))));
+        }
+    }
+    for _round in 0..32 {
+        let midpoints: Vec<P2> = cdt
+            .undirected_edges()
+            .filter_map(|e| {
+                let [a, b] = e.vertices().map(|v| v.fix().index());
+                let dividing = (0..2).any(|s| {
+                    on_loop[s].contains(&a)
+                        && on_loop[s].contains(&b)
+                        && !loop_edges[s].contains(&(a.min(b), a.max(b)))
+                });
+                let [p, q] = e.positions();
+                let mid = [(p.x + q.x) / 2.0, (p.y + q.y) / 2.0];
+                let inside = plan
+                    .boundary
+                    .iter()
+                    .all(|(c, line)| c.hole != in_polygon(mid, line));
+                (dividing && inside && !e.is_constraint_edge()).then_some(mid)
+            })
+            .collect();
+        if midpoints.is_empty() {
+            return Ok(());
+        }
+        for m in midpoints {
+            cdt.insert(Point2::new(m[0], m[1])).map_err(|e| {
+                EmbeddingError::Parameterization(format!("plan point {m:?}: {e:?}"))
+            })?;
+        }
+    }
+    Err(EmbeddingError::Parameterization(
+        "could not remove the edges that join two loops".into(),
+    ))
+}
+
+/// Keeps the faces inside the region and lifts them to the top and bottom faces.
+fn lift(
+    plan: &Plan,
+    cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>,
+    handles: &HashMap<(u64, u64), spade::handles::FixedVertexHandle>,
+    genus: u32,
+) -> Result<HoledMesh, EmbeddingError> {
+    // The region is judged against the polygons actually meshed, not the circles they approximate.
+    let inside = |q: P2| {
+        plan.boundary
+            .iter()
+            .all(|(c, line)| c.hole != in_polygon(q, line))
+    };
+    let faces: Vec<[usize; 3]> = cdt
+        .inner_faces()
+        .filter(|f| {
+            let p = f.positions();
+            inside([
+                (p[0].x + p[1].x + p[2].x) / 3.0,
+                (p[0].y + p[1].y + p[2].y) / 3.0,
+            ])
+        })
+        .map(|f| f.vertices().map(|v| v.fix().index()))
+        .collect();
+    // Boundary vertices (on a circle) are shared by both lifts; the others are doubled.
+    let on_boundary: std::collections::HashSet<usize> = plan
+        .boundary
+        .iter()
+        .flat_map(|(_, line)| line.iter().map(|&p| handles[&key(p)].index()))
+        .collect();
+    let plan_points: Vec<P2> = cdt
+        .vertices()
+        .map(|v| [v.position().x, v.position().y])
+        .collect();
+    let mut top = vec![u32::MAX; cdt.num_vertices()];
+    let mut bottom = vec![u32::MAX; cdt.num_vertices()];
+    let mut positions = Vec::new();
+    for f in &faces {
+        for &v in f {
+            if top[v] != u32::MAX {
+                continue;
+            }
+            let q = plan_points[v];
+            top[v] = positions.len() as u32;
+            positions.push(plan.lift(q, Side::Top));
+            if on_boundary.contains(&v) {
+                bottom[v] = top[v];
+            } else {
+                bottom[v] = positions.len() as u32;
+                positions.push(plan.lift(q, Side::Bottom));
+            }
+        }
+    }
+    let mut triangles = Vec::with_capacity(2 * faces.len());
+    for f in &faces {
+        triangles.push(f.map(|v| top[v]));
+        triangles.push([bottom[f[0]], bottom[f[2]], bottom[f[1]]]);
+    }
+    let loops = plan
+        .loops
+        .iter()
+        .map(|pieces| {
+            let mut path: Vec<u32> = Vec::new();
+            for (side, line) in pieces {
+                let ids = if *side == Side::Top { &top } else { &bottom };
+                for &p in line {
+                    let id = ids[handles[&key(p)].index()];
+                    if path.last() != Some(&id) {
+                        path.push(id);
+                    }
+                }
+            }
+            path
+        })
+        .collect();
+    let base = top[handles.get(&key(plan.base)).map(|v| v.index()).unwrap_or(0)];
+    Ok(HoledMesh {
+        genus,
+        positions,
+        triangles,
+        loops,
+        base: if base == u32::MAX { 0 } else { base },
+        thickness: plan.thickness,
+    })
+}
+
+/// Even-odd test of `q` against a closed polyline.
+fn in_polygon(q: P2, line: &[P2]) -> bool {
+    let mut inside = false;
+    for w in line.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if (a[1] > q[1]) != (b[1] > q[1]) {
+            let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if x > q[0] {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
