@@ -8,7 +8,8 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let res: usize = args.get(1).map_or(32, |s| s.parse().unwrap());
     let grid: usize = args.get(2).map_or(8, |s| s.parse().unwrap());
-    let lambda: f64 = args.get(3).map_or(1e-3, |s| s.parse().unwrap());
+    let lambda: f64 = args.get(3).map_or(1e-4, |s| s.parse().unwrap());
+    let sweeps: usize = args.get(4).map_or(200, |s| s.parse().unwrap());
     for genus in 0..=8 {
         let t = Instant::now();
         let mesh = HoledMesh::new(genus, res).unwrap();
@@ -25,7 +26,8 @@ fn main() {
             ..Default::default()
         };
         let t = Instant::now();
-        let fit = initial_model(genus, res, settings, FitSettings { smoothness: lambda }).unwrap();
+        let fit = initial_model(genus, res, settings, FitSettings { smoothness: lambda, sweeps }).unwrap();
+        let folded = fit.parameterization.folded;
         let flips = fit.parameterization.disk.as_ref().map_or(0, |d| {
             d.triangles
                 .iter()
@@ -67,8 +69,8 @@ fn main() {
             );
         }
         println!(
-            "genus {genus}: V {v} F {f} chi {chi} mesh {:.0?} | flips {flips} | fit {:.0?} rms {:.4} max {:.4} diag {:.3} ({:.3}% / {:.3}%)",
-            t_mesh,
+            "genus {genus}: V {v} F {f} chi {chi} mesh {:.0?} | flips {flips} folded {folded} sweeps {} | fit {:.0?} rms {:.4} max {:.4} diag {:.3} ({:.3}% / {:.3}%)",
+            t_mesh, fit.parameterization.sweeps,
             t.elapsed(),
             fit.rms_residual,
             fit.max_residual,

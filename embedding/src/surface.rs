@@ -33,7 +33,7 @@ impl Default for SplineSettings {
         SplineSettings {
             degree: 3,
             continuity: 2,
-            grid: 8,
+            grid: 12,
         }
     }
 }
