@@ -4,6 +4,8 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use clap::{Parser, Subcommand};
+use embedding::SplineSettings;
+use embedding::fit::FitSettings;
 
 /// ntori: smooth closed surfaces of any genus, built from charts glued by linear fractional maps.
 ///
@@ -115,6 +117,58 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         svg: Option<std::path::PathBuf>,
     },
+    /// Make a new model: a smooth genus-n surface fitted to an n-holed mesh, written as a model file.
+    ///
+    /// The paper's section 5.1. A genus-n mesh (a round plate with n holes, rims rounded; the sphere for
+    /// n = 0, the round torus for n = 1) is cut along 2n loops through one vertex into a disk whose
+    /// boundary reads a₁ b₁ a₁⁻¹ b₁⁻¹ …; Floater's mean value map flattens the disk onto the polygon
+    /// (in the Klein model, where it is convex), the map is relaxed on the closed surface so it has no
+    /// seams, and every chart's control points are fitted at once by regularised least squares.
+    ///
+    /// Prints the fit's checks: folded triangles in the parameterization (0: a bijection), the
+    /// residual |S(p_i) − P_i| at the mesh vertices as a fraction of the mesh's size, and Gauss–Bonnet
+    /// (∫K dA from the analytic curvature against 2π(2 − 2n)). Exit status 3 if a check fails. An
+    /// existing file is not replaced unless --force is given.
+    ///
+    /// Examples:
+    ///   ntori new                                 genus 2, written to model.json
+    ///   ntori new --genus 5 -o five.json --grid 16
+    #[command(verbatim_doc_comment)]
+    New {
+        #[command(flatten)]
+        genus: GenusArg,
+        /// Where to write the model.
+        #[arg(short, long, default_value = "model.json", value_name = "FILE")]
+        output: std::path::PathBuf,
+        /// Replace the output file if it exists.
+        #[arg(long)]
+        force: bool,
+        /// Input mesh resolution: points around each hole (around the equator for the sphere).
+        #[arg(long, default_value_t = 32, value_name = "R",
+              value_parser = clap::value_parser!(u64).range(8..=1024))]
+        resolution: u64,
+        /// Control points per side of each chart's grid.
+        #[arg(long, default_value_t = SplineSettings::default().grid as u64, value_name = "G",
+              value_parser = clap::value_parser!(u64).range(4..=64))]
+        grid: u64,
+        /// Spline degree.
+        #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
+              value_parser = clap::value_parser!(u64).range(1..=7))]
+        degree: u64,
+        /// Continuity order of the blend functions (1 to 4).
+        #[arg(long, default_value_t = SplineSettings::default().continuity as u64, value_name = "K",
+              value_parser = clap::value_parser!(u64).range(1..=4))]
+        continuity: u64,
+        /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term).
+        #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ")]
+        smoothness: f64,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        /// No progress messages on stderr.
+        #[arg(short, long)]
+        quiet: bool,
+    },
     /// Measure throughput and print it as JSON.
     ///
     /// Figures for tessellation, point location, stencil building, re-embedding (also as a fraction
@@ -199,6 +253,54 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             vertices,
             quiet,
         } => bench(genus, vertices, quiet),
+        Command::New {
+            genus: GenusArg { genus },
+            output,
+            force,
+            resolution,
+            grid,
+            degree,
+            continuity,
+            smoothness,
+            json,
+            quiet,
+        } => {
+            if output.exists() && !force {
+                anyhow::bail!(
+                    "{} exists; pass --force to replace it, or -o to write elsewhere",
+                    output.display()
+                );
+            }
+            let settings = SplineSettings {
+                degree: degree as usize,
+                continuity: continuity as usize,
+                grid: grid as usize,
+            };
+            let fit = FitSettings {
+                smoothness,
+                ..FitSettings::default()
+            };
+            let bar = spinner(quiet);
+            let made = ntori::new::make(genus, resolution as usize, settings, fit, &|stage| {
+                bar.set_message(stage.to_string());
+                bar.tick();
+            });
+            bar.finish_and_clear();
+            let (model, report) =
+                made.with_context(|| format!("cannot make a genus-{genus} model"))?;
+            write_atomically(&output, (serde_json::to_string(&model)? + "\n").as_bytes())?;
+            let text = if json {
+                serde_json::to_string_pretty(&report)? + "\n"
+            } else {
+                report.to_text() + &format!("wrote {}\n", output.display())
+            };
+            write_stdout(&text)?;
+            Ok(if report.passed {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(3)
+            })
+        }
         Command::Tessellate {
             genus: GenusArg { genus },
             te,
@@ -231,12 +333,19 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-fn bench(genus: u32, vertices: u64, quiet: bool) -> anyhow::Result<ExitCode> {
-    let bar = if quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+/// A spinner on stderr, hidden when quiet or when stderr is not a terminal.
+fn spinner(quiet: bool) -> indicatif::ProgressBar {
+    if quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         indicatif::ProgressBar::hidden()
     } else {
-        indicatif::ProgressBar::new_spinner()
-    };
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        bar
+    }
+}
+
+fn bench(genus: u32, vertices: u64, quiet: bool) -> anyhow::Result<ExitCode> {
+    let bar = spinner(quiet);
     let report = ntori::bench::run(genus, vertices as usize, &|stage| {
         bar.set_message(format!("measuring {stage}"));
         bar.tick();

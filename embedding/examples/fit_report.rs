@@ -26,7 +26,16 @@ fn main() {
             ..Default::default()
         };
         let t = Instant::now();
-        let fit = initial_model(genus, res, settings, FitSettings { smoothness: lambda, sweeps }).unwrap();
+        let fit = initial_model(
+            genus,
+            res,
+            settings,
+            FitSettings {
+                smoothness: lambda,
+                sweeps,
+            },
+        )
+        .unwrap();
         let folded = fit.parameterization.folded;
         let flips = fit.parameterization.disk.as_ref().map_or(0, |d| {
             d.triangles
@@ -68,9 +77,24 @@ fn main() {
                 p.coords
             );
         }
+        let gb = embedding::integrals::surface_integrals(
+            &layout,
+            &control,
+            std::env::var("CELLS").map_or(4, |s| s.parse().unwrap()),
+        );
+        let expect = std::f64::consts::TAU * (2.0 - 2.0 * genus as f64);
+        println!(
+            "   GB: {:.6} expect {:.6} rel {:.2e} (|K| {:.3}) area {:.3}",
+            gb.gaussian_curvature,
+            expect,
+            (gb.gaussian_curvature - expect).abs() / expect.abs().max(gb.absolute_curvature),
+            gb.absolute_curvature,
+            gb.area
+        );
         println!(
             "genus {genus}: V {v} F {f} chi {chi} mesh {:.0?} | flips {flips} folded {folded} sweeps {} | fit {:.0?} rms {:.4} max {:.4} diag {:.3} ({:.3}% / {:.3}%)",
-            t_mesh, fit.parameterization.sweeps,
+            t_mesh,
+            fit.parameterization.sweeps,
             t.elapsed(),
             fit.rms_residual,
             fit.max_residual,

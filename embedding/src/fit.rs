@@ -58,6 +58,9 @@ pub struct Parameterization {
     pub flat: Vec<[f64; 2]>,
     /// One lift per mesh vertex in the model (Poincaré disk or plane) after relaxation.
     pub lifts: Vec<Complex64>,
+    /// Every disk copy's position after relaxation: its vertex's lift carried by the group element
+    /// that glues the copy's side (so the disk's triangles can be drawn and measured as one piece).
+    pub copies: Vec<Complex64>,
     /// Disk triangles that the relaxed map folds over (0 for a bijection).
     pub folded: usize,
     /// Relaxation sweeps run.
@@ -366,6 +369,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
         disk: None,
         flat: Vec::new(),
         lifts: Vec::new(),
+        copies: Vec::new(),
         folded: 0,
         sweeps: 0,
     }
@@ -403,6 +407,9 @@ fn flatten(
     let mut lifts = Lifts::new(polygon, mesh, &disk, &model, &positions)?;
     let sweeps = lifts.relax(hyperbolic, sweeps, RELAX_TOLERANCE);
     let folded = lifts.folded_triangles(&disk, hyperbolic);
+    let copies = (0..disk.original.len() as u32)
+        .map(|c| lifts.copy_position(&disk, c))
+        .collect();
     let points = lifts
         .home
         .iter()
@@ -413,6 +420,7 @@ fn flatten(
         disk: Some(disk),
         flat,
         lifts: lifts.home,
+        copies,
         folded,
         sweeps,
     })
@@ -489,7 +497,11 @@ impl Lifts {
             let back = to_copy[a].inverse();
             for &(b, w) in list {
                 let u = disk.original[b as usize];
-                neighbours[disk.original[a] as usize].push((w, u, back.compose(&to_copy[b as usize])));
+                neighbours[disk.original[a] as usize].push((
+                    w,
+                    u,
+                    back.compose(&to_copy[b as usize]),
+                ));
             }
         }
         Ok(Lifts {
@@ -558,11 +570,13 @@ impl Lifts {
 
     /// Disk triangles whose lifted corners are not counter-clockwise (hyperbolic or Euclidean area
     /// ≤ 0): a relaxed map that is a bijection has none.
+    fn copy_position(&self, disk: &CutDisk, c: u32) -> Complex64 {
+        let o = disk.original[c as usize];
+        self.to_copy[c as usize].apply(self.home[o as usize])
+    }
+
     fn folded_triangles(&self, disk: &CutDisk, hyperbolic: bool) -> usize {
-        let at = |c: u32| {
-            let o = disk.original[c as usize];
-            self.to_copy[c as usize].apply(self.home[o as usize])
-        };
+        let at = |c: u32| self.copy_position(disk, c);
         disk.triangles
             .iter()
             .filter(|t| {

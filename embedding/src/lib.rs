@@ -26,6 +26,7 @@ pub mod edit;
 pub mod fit;
 pub mod floater;
 pub mod holed;
+pub mod integrals;
 pub mod model;
 pub mod stencil;
 pub mod surface;
