@@ -48,8 +48,7 @@ pub use polygon::{Geometry, Polygon, PolygonConstants, VertexStep};
 pub use scales::{ChartScales, DEFAULT_TABLE};
 pub use tessellation::{
     EDGE_INNER, EDGE_INSIDE_ARC, EDGE_VERTEX_ARC, MAX_RESOLUTION, MAX_TRIANGLES, Region,
-    hyperbolic_area,
-    Tessellation,
+    Tessellation, hyperbolic_area,
 };
 
 /// What can go wrong when asking the charts layer for something.
