@@ -7,6 +7,8 @@ pub mod bench;
 pub mod cell_complex;
 pub mod info;
 pub mod mesh;
+pub mod new;
+pub mod spatial;
 pub mod tessellate;
 
 pub use charts;
