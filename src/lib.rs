@@ -5,8 +5,11 @@
 
 pub mod bench;
 pub mod cell_complex;
+pub mod export;
+pub mod files;
 pub mod info;
 pub mod mesh;
+pub mod model_file;
 pub mod new;
 pub mod spatial;
 pub mod tessellate;
