@@ -52,7 +52,7 @@ pub struct SurfaceMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// A file format [`write`] can produce.
+/// A file format [`write()`] can produce.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Format {
     /// Wavefront OBJ: positions, normals, texture coordinates (text).

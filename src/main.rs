@@ -181,8 +181,8 @@ enum Command {
     ///         (binary little endian, or text with --ascii)
     ///   .stl  triangles with one face normal each; no shared vertices, no texture coordinates
     ///         (binary, or text with --ascii)
-    ///   .glb  binary glTF 2.0: POSITION, NORMAL, TEXCOORD_0 (f32), the chart id as the custom
-    ///         attribute _CHART (u16), u32 indices
+    ///   .glb  binary glTF 2.0: POSITION, NORMAL, TEXCOORD_0 (f32; v flipped, as glTF's textures
+    ///         start at the top), the chart id as the custom attribute _CHART (u16), u32 indices
     ///   .off  positions and triangles only (text)
     /// Texture coordinates are the home chart's coordinates moved into [0, 1]²; they are continuous
     /// within one chart, so triangles whose corners have different home charts span a texture seam.
@@ -207,11 +207,11 @@ enum Command {
         /// Divisions of each edge chart's square (and each arc), 1 to 512. At 1 two different edges
         /// can join the same two vertices, which tools that know edges by their endpoints take for
         /// a non-manifold mesh. Too coarse a tessellation folds (a warning says so).
-        #[arg(long, default_value_t = 16, value_name = "A",
+        #[arg(long, default_value_t = 16, value_name = "A", allow_negative_numbers = true,
               value_parser = clap::value_parser!(u32).range(1..=i64::from(ntori::export::MAX_RESOLUTION)))]
         te: u32,
         /// Divisions of each wheel spoke, 1 to 512.
-        #[arg(long, default_value_t = 16, value_name = "B",
+        #[arg(long, default_value_t = 16, value_name = "B", allow_negative_numbers = true,
               value_parser = clap::value_parser!(u32).range(1..=i64::from(ntori::export::MAX_RESOLUTION)))]
         tr: u32,
         /// Write PLY or STL as text instead of binary.
