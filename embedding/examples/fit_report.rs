@@ -33,6 +33,7 @@ fn main() {
             FitSettings {
                 smoothness: lambda,
                 sweeps,
+                ..Default::default()
             },
         )
         .unwrap();

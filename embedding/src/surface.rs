@@ -33,7 +33,7 @@ impl Default for SplineSettings {
         SplineSettings {
             degree: 3,
             continuity: 2,
-            grid: 12,
+            grid: 16,
         }
     }
 }
@@ -260,6 +260,19 @@ impl<'a> Layout<'a> {
             weight.jet = Jet::quotient(weight.jet, sum);
         }
         sum
+    }
+
+    /// The unblended patch E_c at a point of chart c: each of its (degree + 1)² live control points
+    /// with its basis value (appended to `out`).
+    pub fn patch_weights(&self, p: ChartPoint, out: &mut Vec<(u32, f64)>) {
+        let p1 = self.settings.degree + 1;
+        let (fu, nu) = self.basis.eval(p.coords.re, 0);
+        let (fv, nv) = self.basis.eval(p.coords.im, 0);
+        for (j, y) in nv[0][..p1].iter().enumerate() {
+            for (i, x) in nu[0][..p1].iter().enumerate() {
+                out.push((self.control_index(p.chart, fu + i, fv + j) as u32, x * y));
+            }
+        }
     }
 
     /// The normalised blend of each chart holding `p` (they sum to 1), in chart order.

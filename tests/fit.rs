@@ -1,0 +1,234 @@
+//! The initial fit's acceptance: the n-holed mesh is what it claims, the parameterization is a
+//! bijection onto the surface, and the fitted surface is close to the mesh, immersed, free of
+//! self-intersections and satisfies Gauss–Bonnet.
+
+use charts::{Atlas, Geometry};
+use embedding::fit::{FitSettings, cut, initial_model, parameterize};
+use embedding::holed::HoledMesh;
+use embedding::integrals::surface_integrals;
+use embedding::{Layout, SplineSettings, Stencil};
+use ntori::mesh::HalfEdgeMesh;
+use ntori::spatial::{MeshRef, bounding_box_diagonal, hausdorff, self_intersections};
+
+fn arrays(points: &[embedding::Point3]) -> Vec<[f64; 3]> {
+    points.iter().map(|p| [p.x, p.y, p.z]).collect()
+}
+
+#[test]
+fn holed_meshes_are_closed_genus_n_manifolds_with_simple_canonical_loops() {
+    for genus in 0..=8 {
+        let mesh = HoledMesh::new(genus, 16).unwrap();
+        let topo = HalfEdgeMesh::from_polygons(
+            mesh.positions.len(),
+            mesh.triangles.iter().map(|t| &t[..]),
+        )
+        .unwrap()
+        .topology();
+        assert!(
+            topo.closed && topo.manifold && topo.orientable,
+            "genus {genus}: {topo:?}"
+        );
+        assert_eq!(
+            topo.euler_characteristic,
+            2 - 2 * genus as i64,
+            "genus {genus}"
+        );
+        assert_eq!(topo.components, 1);
+        assert_eq!(mesh.loops.len(), 2 * genus as usize);
+        let mut on_loops = std::collections::HashMap::new();
+        for path in &mesh.loops {
+            assert_eq!((path[0], *path.last().unwrap()), (mesh.base, mesh.base));
+            for &v in &path[1..path.len() - 1] {
+                // Simple, and disjoint from the other loops except at p₀.
+                assert!(
+                    on_loops.insert(v, ()).is_none(),
+                    "genus {genus}: loops meet at {v}"
+                );
+                assert_ne!(v, mesh.base);
+            }
+        }
+        // Outward orientation: the signed volume is positive.
+        let volume: f64 = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+                a.dot(&b.cross(&c)) / 6.0
+            })
+            .sum();
+        assert!(volume > 0.0, "genus {genus}: volume {volume}");
+    }
+}
+
+#[test]
+fn the_cut_is_one_disk_reading_the_polygon_word() {
+    for genus in 1..=8 {
+        let mesh = HoledMesh::new(genus, 16).unwrap();
+        let disk = cut(&mesh).unwrap();
+        let topo =
+            HalfEdgeMesh::from_polygons(disk.original.len(), disk.triangles.iter().map(|t| &t[..]))
+                .unwrap()
+                .topology();
+        assert_eq!(topo.boundary_loops, 1, "genus {genus}");
+        assert_eq!(topo.euler_characteristic, 1, "genus {genus}: a disk");
+        assert_eq!(disk.arcs.len(), 4 * genus as usize);
+        // Arcs on partner sides run along the same loop, in opposite directions.
+        let sides: Vec<usize> = disk.arcs.iter().map(|a| a.1).collect();
+        let mut sorted = sides.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..4 * genus as usize).collect::<Vec<_>>());
+    }
+}
+
+/// Signed areas of the disk's triangles, after relaxation, in the model's geometry.
+fn lifted_areas(genus: u32, resolution: usize) -> (Vec<f64>, usize, usize) {
+    let atlas = Atlas::new(genus).unwrap();
+    let mesh = HoledMesh::new(genus, resolution).unwrap();
+    let s = FitSettings::default();
+    let p = parameterize(&atlas, &mesh, s.sweeps, s.stretch_rounds).unwrap();
+    let disk = p.disk.as_ref().unwrap();
+    let klein_flips = disk
+        .triangles
+        .iter()
+        .filter(|t| {
+            let [a, b, c] = t.map(|v| p.flat[v as usize]);
+            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) <= 0.0
+        })
+        .count();
+    let areas = disk
+        .triangles
+        .iter()
+        .map(|t| {
+            let z = t.map(|c| p.copies[c as usize]);
+            match atlas.geometry() {
+                Geometry::Hyperbolic => charts::hyperbolic_area(z),
+                _ => 0.5 * ((z[1] - z[0]).conj() * (z[2] - z[0])).im,
+            }
+        })
+        .collect();
+    (areas, klein_flips, p.folded)
+}
+
+#[test]
+fn the_parameterization_is_a_bijection_for_genus_1_to_8() {
+    for genus in 1..=8 {
+        let (areas, klein_flips, folded) = lifted_areas(genus, 20);
+        assert_eq!(
+            klein_flips, 0,
+            "genus {genus}: Floater's map flips triangles"
+        );
+        assert_eq!(folded, 0, "genus {genus}: the relaxed map folds");
+        assert!(
+            areas.iter().all(|&a| a > 0.0),
+            "genus {genus}: a degenerate triangle"
+        );
+        // Positive triangles covering exactly the surface's area: a degree-one local homeomorphism
+        // of a closed surface onto itself, so a bijection.
+        let total: f64 = areas.iter().sum();
+        let expected = match genus {
+            1 => 1.0,
+            n => 4.0 * std::f64::consts::PI * (f64::from(n) - 1.0),
+        };
+        assert!(
+            (total - expected).abs() < 1e-6 * expected,
+            "genus {genus}: area {total} vs {expected}"
+        );
+    }
+}
+
+#[test]
+fn the_sphere_is_parameterized_stereographically() {
+    let atlas = Atlas::new(0).unwrap();
+    let mesh = HoledMesh::new(0, 24).unwrap();
+    let p = parameterize(&atlas, &mesh, 0, 0).unwrap();
+    // Every vertex lands well inside a cap, and the caps' images agree with the 3D directions.
+    for (point, x) in p.points.iter().zip(&mesh.positions) {
+        let z = atlas.to_model(*point).unwrap().0;
+        let back = if point.chart.0 == 0 || z.norm() < 1e6 {
+            let d = 1.0 + z.norm_sqr();
+            embedding::Point3::new(2.0 * z.re / d, 2.0 * z.im / d, (1.0 - z.norm_sqr()) / d)
+        } else {
+            embedding::Point3::new(0.0, 0.0, -1.0)
+        };
+        assert!((back - x / x.norm()).norm() < 1e-9, "{x} → {z}");
+    }
+}
+
+#[test]
+fn fitted_surfaces_are_close_immersed_embedded_and_satisfy_gauss_bonnet() {
+    let settings = SplineSettings::default();
+    for genus in 0..=6 {
+        let fit = initial_model(genus, 32, settings, FitSettings::default()).unwrap();
+        let atlas = Atlas::new(genus).unwrap();
+        let layout = Layout::new(&atlas, settings).unwrap();
+        let control = fit.model.points();
+        let surface = |te: u32| {
+            let t = atlas.tessellate(te, te).unwrap();
+            let stencil = Stencil::build(&layout, &t.vertices);
+            let mut pos = vec![embedding::Point3::zeros(); t.vertices.len()];
+            stencil.positions(&control, &mut pos);
+            (t, arrays(&pos))
+        };
+        let input = arrays(&fit.mesh.positions);
+        let diagonal = bounding_box_diagonal(&input).unwrap();
+
+        // Close: symmetric Hausdorff distance to the input mesh, against a fine tessellation.
+        let (fine, fine_pos) = surface(24);
+        let d = hausdorff(
+            MeshRef {
+                positions: &input,
+                triangles: &fit.mesh.triangles,
+            },
+            MeshRef {
+                positions: &fine_pos,
+                triangles: &fine.triangles,
+            },
+        )
+        .unwrap();
+        assert!(
+            d.symmetric <= 0.01 * diagonal,
+            "genus {genus}: Hausdorff {} = {:.3}% of the diagonal",
+            d.symmetric,
+            100.0 * d.symmetric / diagonal
+        );
+
+        // Immersed: the area element at every vertex of the t = 8 tessellation is far from zero.
+        let (coarse, coarse_pos) = surface(8);
+        let elements: Vec<f64> = coarse
+            .vertices
+            .iter()
+            .map(|p| layout.eval(&control, *p).area_element())
+            .collect();
+        let mut sorted = elements.clone();
+        sorted.sort_by(f64::total_cmp);
+        let (least, median) = (sorted[0], sorted[sorted.len() / 2]);
+        assert!(
+            least > 1e-3 * median,
+            "genus {genus}: |S_u × S_v| falls to {least} (median {median})"
+        );
+
+        // Embedded: no two triangles of the t = 8 tessellation meet where they should not.
+        let crossings = self_intersections(&coarse_pos, &coarse.triangles).unwrap();
+        assert!(
+            crossings.is_empty(),
+            "genus {genus}: {} intersecting pairs, e.g. {:?}",
+            crossings.len(),
+            &crossings[..crossings.len().min(3)]
+        );
+
+        // Gauss–Bonnet from the analytic curvature.
+        let sums = surface_integrals(&layout, &control, 8);
+        let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
+        let error = (sums.gaussian_curvature - expected).abs();
+        assert!(
+            error <= 1e-3 * expected.abs().max(sums.absolute_curvature),
+            "genus {genus}: ∫K dA = {} vs {expected}",
+            sums.gaussian_curvature
+        );
+        eprintln!(
+            "genus {genus}: Hausdorff {:.3}%, min/median area element {:.3}, GB error {error:.1e}",
+            100.0 * d.symmetric / diagonal,
+            least / median
+        );
+    }
+}
