@@ -1,0 +1,382 @@
+//! The renderer: one wgpu pipeline set (`shaders/*.wgsl`) for the editor's viewport and for
+//! headless pictures. Offscreen it needs no window and no GPU: Mesa's software Vulkan (lavapipe)
+//! is enough, which is what CI uses.
+//!
+//! Styles: shaded; wireframe (the tessellation's edges over the shading); charts (each vertex
+//! coloured by its blend weights, one colour per chart); curvature (Gaussian or mean curvature on a
+//! diverging scale, with a legend).
+
+pub mod gpu;
+mod legend;
+pub mod scene;
+
+use embedding::Model;
+
+use gpu::{DEPTH_FORMAT, GpuScene, SurfaceRenderer};
+use scene::{Camera, SceneGeometry};
+
+/// What can go wrong when rendering.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error(
+        "no graphics adapter is available ({0}); install a Vulkan driver (on Debian or Ubuntu, Mesa's software one: apt-get install mesa-vulkan-drivers)"
+    )]
+    NoAdapter(String),
+    #[error("the graphics device could not be opened: {0}")]
+    Device(String),
+    #[error("an image of {width}×{height} pixels is not possible (1 to {max} per side)")]
+    Size { width: u32, height: u32, max: u32 },
+    #[error("{0}")]
+    View(String),
+    #[error("the mesh cannot be drawn: {0}")]
+    Mesh(String),
+    #[error("reading the image back from the GPU failed: {0}")]
+    Readback(String),
+    #[error("the PNG could not be encoded: {0}")]
+    Png(String),
+    #[error(transparent)]
+    Model(#[from] embedding::EmbeddingError),
+    #[error(transparent)]
+    Charts(#[from] charts::ChartsError),
+}
+
+/// Where the camera is: degrees around the vertical axis (z) and above the horizontal plane, and
+/// how far from the centre, in radii of the bounding sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    pub azimuth_deg: f64,
+    pub elevation_deg: f64,
+    pub distance: f64,
+}
+
+impl Default for View {
+    fn default() -> Self {
+        View {
+            azimuth_deg: 30.0,
+            elevation_deg: 35.0,
+            distance: 3.6,
+        }
+    }
+}
+
+impl View {
+    /// Checks the numbers: finite, elevation within ±90°, distance beyond the bounding sphere.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let finite = [self.azimuth_deg, self.elevation_deg, self.distance]
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite || self.elevation_deg.abs() > 90.0 || !(1.05..=1000.0).contains(&self.distance)
+        {
+            return Err(RenderError::View(format!(
+                "the view azimuth {}, elevation {}, distance {} is not possible: elevation must lie in −90 to 90 degrees and the distance in 1.05 to 1000 bounding radii",
+                self.azimuth_deg, self.elevation_deg, self.distance
+            )));
+        }
+        Ok(())
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CurvatureKind {
+    Gaussian,
+    Mean,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Style {
+    Shaded,
+    Wireframe,
+    Charts,
+    Curvature(CurvatureKind),
+}
+
+/// A picture's size, view, style and tessellation (t_e = t_r).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    pub view: View,
+    pub style: Style,
+    pub tessellation: u32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 1024,
+            height: 768,
+            view: View::default(),
+            style: Style::Shaded,
+            tessellation: 32,
+        }
+    }
+}
+
+/// A polyline on the surface, drawn on top of it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Curve {
+    pub points: Vec<[f64; 3]>,
+    pub colour: [f32; 3],
+}
+
+/// An RGBA image, rows top to bottom.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+}
+
+impl Image {
+    /// PNG bytes (deterministic: same pixels, same bytes).
+    pub fn to_png(&self) -> Result<Vec<u8>, RenderError> {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, self.width, self.height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder
+            .write_header()
+            .map_err(|e| RenderError::Png(e.to_string()))?;
+        writer
+            .write_image_data(&self.rgba)
+            .map_err(|e| RenderError::Png(e.to_string()))?;
+        writer.finish().map_err(|e| RenderError::Png(e.to_string()))?;
+        Ok(out)
+    }
+}
+
+/// The colour format of offscreen pictures: plain 8-bit, so the shader's colours are the pixels.
+const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Multisampling for smooth silhouettes.
+const SAMPLES: u32 = 4;
+/// The largest picture side accepted.
+pub const MAX_SIDE: u32 = 8192;
+
+/// A GPU device for pictures without a window, reused from one picture to the next.
+pub struct Offscreen {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    renderer: SurfaceRenderer,
+    adapter_name: String,
+}
+
+impl Offscreen {
+    /// Opens the first adapter wgpu finds (a GPU, or Mesa's lavapipe on a machine without one).
+    pub fn new() -> Result<Offscreen, RenderError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        let adapter_name = adapter.get_info().name;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("ntori offscreen"),
+                required_features: wgpu::Features::empty(),
+                required_limits: wgpu::Limits::downlevel_defaults()
+                    .using_resolution(adapter.limits()),
+                experimental_features: Default::default(),
+                memory_hints: wgpu::MemoryHints::MemoryUsage,
+                trace: Default::default(),
+            }))
+            .map_err(|e| RenderError::Device(e.to_string()))?;
+        let renderer = SurfaceRenderer::new(&device, OFFSCREEN_FORMAT, SAMPLES);
+        tracing::info!(adapter = %adapter_name, "offscreen renderer ready");
+        Ok(Offscreen {
+            device,
+            queue,
+            renderer,
+            adapter_name,
+        })
+    }
+
+    /// The adapter's name (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)").
+    pub fn adapter_name(&self) -> &str {
+        &self.adapter_name
+    }
+
+    /// The model's surface, tessellated at `options.tessellation`, as PNG bytes.
+    pub fn render_model_png(
+        &mut self,
+        model: &Model,
+        options: &RenderOptions,
+        curves: &[Curve],
+    ) -> Result<Vec<u8>, RenderError> {
+        self.render_model(model, options, curves)?.to_png()
+    }
+
+    /// The model's surface as an image.
+    pub fn render_model(
+        &mut self,
+        model: &Model,
+        options: &RenderOptions,
+        curves: &[Curve],
+    ) -> Result<Image, RenderError> {
+        self.check(options)?;
+        let geometry =
+            scene::model_geometry(model, options.tessellation, options.style, curves)?;
+        self.draw(&geometry, options)
+    }
+
+    /// A triangle mesh (flat shaded) as PNG bytes.
+    pub fn render_mesh_png(
+        &mut self,
+        positions: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        options: &RenderOptions,
+    ) -> Result<Vec<u8>, RenderError> {
+        self.check(options)?;
+        let geometry = scene::mesh_geometry(positions, triangles)?;
+        self.draw(&geometry, options)?.to_png()
+    }
+
+    fn check(&self, options: &RenderOptions) -> Result<(), RenderError> {
+        let max = MAX_SIDE.min(self.device.limits().max_texture_dimension_2d);
+        if !(1..=max).contains(&options.width) || !(1..=max).contains(&options.height) {
+            return Err(RenderError::Size {
+                width: options.width,
+                height: options.height,
+                max,
+            });
+        }
+        options.view.validate()
+    }
+
+    fn draw(&self, geometry: &SceneGeometry, options: &RenderOptions) -> Result<Image, RenderError> {
+        let (width, height) = (options.width, options.height);
+        let camera = Camera {
+            centre: geometry.centre,
+            radius: geometry.radius,
+            view: options.view,
+            aspect: width as f32 / height as f32,
+        };
+        let scene = GpuScene::new(&self.device, &geometry.vertices, &geometry.segments);
+        self.renderer
+            .set_frame(&self.queue, &camera.uniforms(options.style, (width, height)));
+        let target = |label, format, samples, usage| {
+            self.device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d {
+                        width,
+                        height,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: samples,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+        };
+        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let msaa = target("ntori msaa", OFFSCREEN_FORMAT, SAMPLES, attachment);
+        let resolved = target(
+            "ntori picture",
+            OFFSCREEN_FORMAT,
+            1,
+            attachment | wgpu::TextureUsages::COPY_SRC,
+        );
+        let depth = target("ntori depth", DEPTH_FORMAT, SAMPLES, attachment);
+        let views = [&msaa, &resolved, &depth].map(|t| t.create_view(&Default::default()));
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("ntori picture"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &views[0],
+                    depth_slice: None,
+                    resolve_target: Some(&views[1]),
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Discard,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &views[2],
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.renderer.paint(&mut pass, &scene);
+        }
+        let mut image = self.read_back(encoder, &resolved, width, height)?;
+        if let Some((kind, range)) = geometry.legend {
+            legend::draw(&mut image, kind, range);
+        }
+        Ok(image)
+    }
+
+    fn read_back(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        width: u32,
+        height: u32,
+    ) -> Result<Image, RenderError> {
+        let row = 4 * width;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ntori readback"),
+            size: u64::from(padded) * u64::from(height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        self.queue.submit([encoder.finish()]);
+        let slice = buffer.slice(..);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = sender.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        receiver
+            .recv()
+            .map_err(|e| RenderError::Readback(e.to_string()))?
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        let mut rgba = Vec::with_capacity((row * height) as usize);
+        for y in 0..height as usize {
+            let start = y * padded as usize;
+            rgba.extend_from_slice(&data[start..start + row as usize]);
+        }
+        drop(data);
+        buffer.unmap();
+        Ok(Image {
+            width,
+            height,
+            rgba,
+        })
+    }
+}

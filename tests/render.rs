@@ -1,0 +1,154 @@
+//! The offscreen renderer on whatever adapter the machine has (Mesa's lavapipe in CI): pictures are
+//! non-trivial, styles differ as they should, and the same input gives the same bytes.
+
+use embedding::fit::{FitSettings, initial_model};
+use embedding::{Model, SplineSettings};
+use ntori::render::{CurvatureKind, Image, Offscreen, RenderError, RenderOptions, Style, View};
+
+fn model() -> Model {
+    let settings = SplineSettings {
+        grid: 8,
+        ..SplineSettings::default()
+    };
+    initial_model(2, 16, settings, FitSettings::default())
+        .unwrap()
+        .model
+}
+
+fn offscreen() -> Offscreen {
+    Offscreen::new().expect("a graphics adapter (CI installs mesa-vulkan-drivers)")
+}
+
+fn options(style: Style) -> RenderOptions {
+    RenderOptions {
+        width: 320,
+        height: 240,
+        style,
+        tessellation: 12,
+        ..RenderOptions::default()
+    }
+}
+
+/// Pixels that are not the white background.
+fn surface_pixels(image: &Image) -> Vec<[u8; 3]> {
+    image
+        .rgba
+        .chunks(4)
+        .filter(|p| p[..3] != [255, 255, 255])
+        .map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
+
+fn luminance(p: [u8; 3]) -> f64 {
+    0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
+}
+
+#[test]
+fn the_default_view_shows_a_shaded_surface_and_is_stable() {
+    let model = model();
+    let mut gpu = offscreen();
+    let image = gpu.render_model(&model, &options(Style::Shaded), &[]).unwrap();
+    assert_eq!((image.width, image.height), (320, 240));
+    assert_eq!(image.rgba.len(), 320 * 240 * 4);
+    let surface = surface_pixels(&image);
+    let covered = surface.len() as f64 / (320.0 * 240.0);
+    assert!(
+        (0.15..0.85).contains(&covered),
+        "the surface covers {covered:.2} of the picture"
+    );
+    let lum: Vec<f64> = surface.iter().map(|&p| luminance(p)).collect();
+    let mean = lum.iter().sum::<f64>() / lum.len() as f64;
+    let sd = (lum.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lum.len() as f64).sqrt();
+    assert!(sd > 10.0, "shading hardly varies (sd {sd:.1})");
+    // Same input, same bytes; a different view, different bytes.
+    let a = gpu.render_model_png(&model, &options(Style::Shaded), &[]).unwrap();
+    let b = gpu.render_model_png(&model, &options(Style::Shaded), &[]).unwrap();
+    assert_eq!(a, b);
+    let mut turned = options(Style::Shaded);
+    turned.view.azimuth_deg += 90.0;
+    assert_ne!(a, gpu.render_model_png(&model, &turned, &[]).unwrap());
+    assert_eq!(&a[1..4], b"PNG");
+}
+
+#[test]
+fn styles_colour_the_surface_as_they_say() {
+    let model = model();
+    let mut gpu = offscreen();
+    let shaded = gpu.render_model(&model, &options(Style::Shaded), &[]).unwrap();
+    let wire = gpu.render_model(&model, &options(Style::Wireframe), &[]).unwrap();
+    // Wireframe darkens the edges: more dark pixels than plain shading.
+    let dark = |im: &Image| surface_pixels(im).iter().filter(|&&p| luminance(p) < 60.0).count();
+    assert!(dark(&wire) > dark(&shaded) + 500, "{} vs {}", dark(&wire), dark(&shaded));
+    // Charts: several clearly different hues.
+    let charts = gpu.render_model(&model, &options(Style::Charts), &[]).unwrap();
+    let mut hues: Vec<u8> = surface_pixels(&charts)
+        .iter()
+        .filter(|p| p.iter().max().unwrap() - p.iter().min().unwrap() > 60)
+        .map(|p| {
+            let i = (0..3).max_by_key(|&i| p[i]).unwrap();
+            let j = (0..3).filter(|&j| j != i).max_by_key(|&j| p[j]).unwrap();
+            (3 * i + j) as u8
+        })
+        .collect();
+    hues.sort_unstable();
+    hues.dedup();
+    assert!(hues.len() >= 3, "chart colours: {hues:?}");
+    // Curvature: the holes' saddles are blue, the outer rim red, and a legend is drawn.
+    let k = gpu
+        .render_model(&model, &options(Style::Curvature(CurvatureKind::Gaussian)), &[])
+        .unwrap();
+    let px = surface_pixels(&k);
+    let blue = px.iter().filter(|p| i32::from(p[2]) > i32::from(p[0]) + 60).count();
+    let red = px.iter().filter(|p| i32::from(p[0]) > i32::from(p[2]) + 40).count();
+    assert!(blue > 100 && red > 100, "blue {blue}, red {red}");
+}
+
+#[test]
+fn curves_are_drawn_on_top() {
+    let model = model();
+    let mut gpu = offscreen();
+    let plain = gpu.render_model(&model, &options(Style::Shaded), &[]).unwrap();
+    let ring: Vec<[f64; 3]> = (0..=64)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / 64.0;
+            [3.0 * a.cos(), 3.0 * a.sin(), 0.6]
+        })
+        .collect();
+    let curve = ntori::render::Curve {
+        points: ring,
+        colour: [1.0, 0.0, 0.0],
+    };
+    let with = gpu.render_model(&model, &options(Style::Shaded), &[curve]).unwrap();
+    let red = |im: &Image| im.rgba.chunks(4).filter(|p| p[0] > 200 && p[1] < 40).count();
+    assert_eq!(red(&plain), 0);
+    assert!(red(&with) > 200, "{} red pixels", red(&with));
+}
+
+#[test]
+fn impossible_requests_are_errors() {
+    let model = model();
+    let mut gpu = offscreen();
+    for (w, h) in [(0, 10), (10, 0), (100_000, 10)] {
+        let o = RenderOptions {
+            width: w,
+            height: h,
+            ..options(Style::Shaded)
+        };
+        assert!(matches!(
+            gpu.render_model(&model, &o, &[]),
+            Err(RenderError::Size { .. })
+        ));
+    }
+    for view in [
+        View { elevation_deg: 95.0, ..View::default() },
+        View { distance: 0.5, ..View::default() },
+        View { azimuth_deg: f64::NAN, ..View::default() },
+    ] {
+        let o = RenderOptions { view, ..options(Style::Shaded) };
+        assert!(matches!(gpu.render_model(&model, &o, &[]), Err(RenderError::View(_))));
+    }
+    let mut broken = model.clone();
+    broken.control_points.pop();
+    assert!(gpu.render_model(&broken, &options(Style::Shaded), &[]).is_err());
+    assert!(gpu.render_mesh_png(&[[0.0; 3]], &[[0, 1, 2]], &options(Style::Shaded)).is_err());
+}
