@@ -301,10 +301,13 @@ impl Plan {
         }
     }
 
-    /// The typical spacing of boundary points for a resolution (points around a hole).
+    /// The typical spacing of boundary points for a resolution (points around a hole; for the
+    /// sphere, half its equator).
     fn spacing(genus: u32, resolution: usize) -> f64 {
+        // The torus's hole has radius 1; the plates' holes 0.5. The sphere's plan (radius 1) is
+        // stretched by up to π/2 near its rim, so it gets the plates' finer spacing.
         let radius = match genus {
-            0 | 1 => 1.0,
+            1 => 1.0,
             _ => 0.5,
         };
         TAU * radius / resolution as f64
@@ -349,7 +352,7 @@ impl Plan {
 }
 
 impl HoledMesh {
-    /// The genus-n mesh at `resolution` (boundary points around a hole, or around the sphere's equator;
+    /// The genus-n mesh at `resolution` (boundary points around a hole, or around half the sphere's equator;
     /// 8 to 1024). Triangles have angles ≥ 20° in the plan; the rounded rims stretch them by up to π/2
     /// across the band.
     pub fn new(genus: u32, resolution: usize) -> Result<HoledMesh, EmbeddingError> {
