@@ -54,4 +54,26 @@ fn render_writes_a_png_and_refuses_nonsense() {
         .failure()
         .stderr(predicate::str::contains("nope.json"));
     assert!(!dir.path().join("x.png").exists());
+    // An output directory that does not exist: named in the message, nothing written.
+    let nowhere = dir.path().join("no-such-dir").join("x.png");
+    ntori()
+        .arg("render")
+        .arg(&model)
+        .args(["--size", "64x48", "-o"])
+        .arg(&nowhere)
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("no-such-dir"));
+    // A model from a newer ntori is refused as such.
+    let future = dir.path().join("future.json");
+    let text = std::fs::read_to_string(&model).unwrap();
+    std::fs::write(&future, text.replace("\"version\":1", "\"version\":99")).unwrap();
+    ntori()
+        .arg("render")
+        .arg(&future)
+        .arg("-o")
+        .arg(dir.path().join("x.png"))
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("future.json").and(predicate::str::contains("99")));
 }
