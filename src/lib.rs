@@ -6,6 +6,7 @@
 pub mod bench;
 pub mod cell_complex;
 pub mod export;
+pub mod figures;
 pub mod files;
 pub mod info;
 pub mod mesh;

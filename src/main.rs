@@ -268,6 +268,32 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
+    /// Regenerate the paper's figures: SVG drawings, PNG renderings, and a caption file.
+    ///
+    /// Writes into DIR (created if needed): figure 1 (the abstract 4n-gon with its edge pairing),
+    /// figure 2 (left: the corners in their order around the surface's vertex, SVG; right: the loops
+    /// a₁ b₁ a₂ b₂ on the surface, PNG), figure 3 (the hyperbolic polygon with ω, h, r, γ, α, β),
+    /// figure 4 (the three chart kinds, in their coordinates and in the polygon), figure 5 (the
+    /// overlap regions), figure 6 (the input mesh, the fitted surface, two edited surfaces; PNG),
+    /// figure 7 (the tessellation), a gallery (genus 0 to 6, and genus 2 in the chart and curvature
+    /// styles; PNG), and CAPTIONS.md listing every file with what it shows and the parameters that
+    /// made it. The 2D figures are for genus 2, like the paper's.
+    ///
+    /// The PNG figures need a GPU (or a software adapter); without one they are left out with a
+    /// warning, and the caption file says so. Running the command again writes the same bytes.
+    ///
+    /// Examples:
+    ///   ntori figures                       into ./figures
+    ///   ntori figures --out paper --quiet
+    #[command(verbatim_doc_comment)]
+    Figures {
+        /// The directory to write the figures into.
+        #[arg(long, default_value = "figures", value_name = "DIR")]
+        out: std::path::PathBuf,
+        /// No progress bar on stderr.
+        #[arg(short, long)]
+        quiet: bool,
+    },
     /// Measure throughput and print it as JSON.
     ///
     /// Figures for tessellation, point location, stencil building, re-embedding (also as a fraction
@@ -437,6 +463,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             };
             render(&model, &output, &options, quiet)
         }
+        Command::Figures { out, quiet } => figures(&out, quiet),
         Command::Tessellate {
             genus: GenusArg { genus },
             te,
@@ -564,6 +591,39 @@ fn render(
             options.width,
             options.height,
             offscreen.adapter_name()
+        ))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn figures(out: &std::path::Path, quiet: bool) -> anyhow::Result<ExitCode> {
+    use ntori::figures::Progress;
+    let bar = if quiet || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let bar = indicatif::ProgressBar::new(0);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    };
+    let options = ntori::figures::Options::default();
+    let summary = ntori::figures::generate(out, &options, &mut |p| match p {
+        Progress::Total(n) => bar.set_length(n),
+        Progress::Making(file) => bar.set_message(file),
+        Progress::Done => bar.inc(1),
+    });
+    bar.finish_and_clear();
+    let summary = summary?;
+    for note in &summary.notes {
+        eprintln!("ntori: warning: {note}");
+    }
+    if !quiet {
+        write_stdout(&format!(
+            "wrote {} files to {}\n",
+            summary.written.len(),
+            out.display()
         ))?;
     }
     Ok(ExitCode::SUCCESS)

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use charts::check::consistency_at;
-use charts::{Atlas, ChartKind, Geometry, Lft, Region, Tessellation};
+use charts::{Atlas, ChartKind, Geometry, Lft, Polygon, Region, Tessellation};
 use num_complex::Complex64;
 use serde::Serialize;
 
@@ -163,22 +163,20 @@ impl TessellationReport {
     }
 }
 
-/// Colours: the inside wheel, the vertex wheel, then one per edge chart.
-fn fill(kind: ChartKind, region: Region) -> String {
+/// The fill colour of a triangle: its home chart's tint (see [`crate::figures::palette`]).
+pub fn fill(kind: ChartKind, region: Region) -> String {
+    use crate::figures::palette;
     match (region, kind) {
-        (Region::InsideWheel, ChartKind::Cap { north: false }) => "#8fb8de".into(),
-        (Region::InsideWheel, _) => "#f6c28b".into(),
-        (Region::VertexWheel, _) => "#9fd3b5".into(),
-        (Region::Square, ChartKind::Edge { handle, side }) => {
-            let hue = (f64::from(2 * handle + side) * 137.508 + 200.0) % 360.0;
-            format!("hsl({hue:.0},55%,72%)")
-        }
+        (Region::InsideWheel, ChartKind::Cap { .. }) => palette::fill(kind),
+        (Region::InsideWheel, _) => palette::fill(ChartKind::Inside),
+        (Region::VertexWheel, _) => palette::fill(ChartKind::Vertex),
+        (Region::Square, ChartKind::Edge { .. }) => palette::fill(kind),
         (Region::Square, _) => "#cccccc".into(),
     }
 }
 
 /// An SVG path command from p0 to p1 along the circle through pm (a straight line if nearly flat).
-fn arc_to(out: &mut String, p0: Complex64, pm: Complex64, p1: Complex64) {
+pub fn arc_to(out: &mut String, p0: Complex64, pm: Complex64, p1: Complex64) {
     let cross = ((pm - p0).conj() * (p1 - pm)).im;
     let chord = (p1 - p0).norm();
     if cross.abs() <= 1e-9 * chord * chord {
@@ -207,37 +205,53 @@ fn arc_to(out: &mut String, p0: Complex64, pm: Complex64, p1: Complex64) {
     );
 }
 
-/// The tessellation drawn in the fundamental polygon (the paper's figure 7), charts coloured: each
-/// triangle with its true (circular) sides, moved into the polygon by the group, clipped to it. For the
-/// sphere, the two caps side by side, each in its own coordinate ζ or 1/ζ.
-pub fn svg(atlas: &Atlas, t: &Tessellation) -> String {
-    let mut body = String::new();
-    let (view, clip) = match (atlas.geometry(), atlas.polygon()) {
-        (Geometry::Spherical, _) => ("-1.15 -1.15 4.5 2.3".to_string(), None),
-        (_, Some(poly)) => {
-            let r = if atlas.geometry() == Geometry::Euclidean {
-                0.6
-            } else {
-                1.05
-            };
-            let mut path = String::new();
-            let corners = poly.corners();
-            let _ = write!(path, "M{:.6} {:.6}", corners[0].re, corners[0].im);
-            for e in 1..=corners.len() {
-                let e = e % corners.len();
-                let (a, b) = poly.edge_corners(e);
-                let mid = Complex64::from_polar(
-                    poly.constants().gamma,
-                    e as f64 * poly.constants().omega,
-                );
-                arc_to(&mut path, corners[a], mid, corners[b]);
-            }
-            path.push_str(" Z");
-            (format!("{} {} {} {}", -r, -r, 2.0 * r, 2.0 * r), Some(path))
-        }
-        _ => unreachable!("polygon atlases have a polygon"),
-    };
-    let stroke = (0.8 / (t.triangles.len() as f64).sqrt()).clamp(0.0004, 0.004);
+/// The fundamental polygon's outline as SVG path data (its sides the circular arcs they are), each
+/// point taken through `map` (model coordinates to drawing coordinates; a similarity, so arcs stay arcs).
+pub fn polygon_path(poly: &Polygon, map: impl Fn(Complex64) -> Complex64) -> String {
+    let mut path = String::new();
+    let corners: Vec<Complex64> = poly.corners().iter().map(|&c| map(c)).collect();
+    let _ = write!(path, "M{:.6} {:.6}", corners[0].re, corners[0].im);
+    for e in 1..=corners.len() {
+        let e = e % corners.len();
+        let (a, b) = poly.edge_corners(e);
+        let mid = Complex64::from_polar(poly.constants().gamma, e as f64 * poly.constants().omega);
+        arc_to(&mut path, corners[a], map(mid), corners[b]);
+    }
+    path.push_str(" Z");
+    path
+}
+
+/// One copy of a tessellation triangle in the model: its corners and the images of its sides'
+/// midpoints (which fix the circular arcs its sides are).
+#[derive(Clone, Copy, Debug)]
+pub struct DrawnTriangle {
+    /// Index into the tessellation's triangles.
+    pub triangle: usize,
+    pub corners: [Complex64; 3],
+    pub mids: [Complex64; 3],
+}
+
+impl DrawnTriangle {
+    /// SVG path data of the triangle with circular sides, each point taken through `map` (a
+    /// similarity from model to drawing coordinates).
+    pub fn path(&self, map: impl Fn(Complex64) -> Complex64) -> String {
+        let [a, b, c] = self.corners.map(&map);
+        let m = self.mids.map(&map);
+        let mut d = format!("M{:.6} {:.6}", a.re, a.im);
+        arc_to(&mut d, a, m[0], b);
+        arc_to(&mut d, b, m[1], c);
+        arc_to(&mut d, c, m[2], a);
+        d.push_str(" Z");
+        d
+    }
+}
+
+/// Every triangle of `t` as drawn in the model: moved into the fundamental polygon by the group, plus
+/// one more copy for each tile its corners reach (so that, clipped to the polygon, the copies cover
+/// exactly the triangle's part of the surface). For the sphere, the two caps side by side, each in
+/// its own coordinate ζ or 1/ζ (the south cap shifted right by 2.3).
+pub fn drawn_triangles(atlas: &Atlas, t: &Tessellation) -> Vec<DrawnTriangle> {
+    let mut out = Vec::with_capacity(t.triangles.len());
     for (k, coords) in t.triangle_coords.iter().enumerate() {
         let chart = &atlas.charts()[t.triangle_charts[k].index()];
         let phi = *chart.to_model();
@@ -265,18 +279,44 @@ pub fn svg(atlas: &Atlas, t: &Tessellation) -> String {
             }
         };
         for g in copies {
-            let [a, b, c] = corners.map(|z| g.apply(z));
-            let m = mids.map(|z| g.apply(z));
-            let mut d = format!("M{:.6} {:.6}", a.re, a.im);
-            arc_to(&mut d, a, m[0], b);
-            arc_to(&mut d, b, m[1], c);
-            arc_to(&mut d, c, m[2], a);
-            let _ = writeln!(
-                body,
-                "<path d=\"{d} Z\" fill=\"{}\"/>",
-                fill(chart.kind(), t.triangle_regions[k])
-            );
+            out.push(DrawnTriangle {
+                triangle: k,
+                corners: corners.map(|z| g.apply(z)),
+                mids: mids.map(|z| g.apply(z)),
+            });
         }
+    }
+    out
+}
+
+/// The tessellation drawn in the fundamental polygon (the paper's figure 7), charts coloured: each
+/// triangle with its true (circular) sides, moved into the polygon by the group, clipped to it. For the
+/// sphere, the two caps side by side, each in its own coordinate ζ or 1/ζ.
+pub fn svg(atlas: &Atlas, t: &Tessellation) -> String {
+    let mut body = String::new();
+    let (view, clip) = match (atlas.geometry(), atlas.polygon()) {
+        (Geometry::Spherical, _) => ("-1.15 -1.15 4.5 2.3".to_string(), None),
+        (_, Some(poly)) => {
+            let r = if atlas.geometry() == Geometry::Euclidean {
+                0.6
+            } else {
+                1.05
+            };
+            let path = polygon_path(poly, |z| z);
+            (format!("{} {} {} {}", -r, -r, 2.0 * r, 2.0 * r), Some(path))
+        }
+        _ => unreachable!("polygon atlases have a polygon"),
+    };
+    let stroke = (0.8 / (t.triangles.len() as f64).sqrt()).clamp(0.0004, 0.004);
+    for drawn in drawn_triangles(atlas, t) {
+        let k = drawn.triangle;
+        let chart = &atlas.charts()[t.triangle_charts[k].index()];
+        let _ = writeln!(
+            body,
+            "<path d=\"{}\" fill=\"{}\"/>",
+            drawn.path(|z| z),
+            fill(chart.kind(), t.triangle_regions[k])
+        );
     }
     let mut s = String::new();
     let _ = writeln!(
