@@ -606,6 +606,8 @@ fn figures(out: &std::path::Path, quiet: bool) -> anyhow::Result<ExitCode> {
             indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
+        // The 3D figures fit surfaces for seconds at a time: keep the bar alive meanwhile.
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
         bar
     };
     let options = ntori::figures::Options::default();

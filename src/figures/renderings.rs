@@ -163,33 +163,29 @@ struct Scripted {
 }
 
 /// "Pull the outer rim out", as a user would drag it: five points along the rim around the +x
-/// direction and three on each face just inside it move outwards, by up to a tenth of the plate's
-/// width (less away from the middle); five points on the far side are pinned.
+/// direction move outwards, by up to 7% of the plate's width (less away from the middle); five
+/// points on the far side are pinned.
 fn pull_rim(fit: &InitialFit) -> Scripted {
     let p = &fit.mesh.positions;
     let (lo, hi) = bounds(p);
     let centre = Point3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.0);
-    let (reach, half) = (hi.x - centre.x, 0.5 * (hi.z - lo.z));
+    let reach = hi.x - centre.x;
     let at = |r: f64, degrees: f64, z: f64| {
         let a = degrees.to_radians();
         centre + Point3::new(r * a.cos(), r * a.sin(), z)
     };
-    let amount = 0.1 * (hi.x - lo.x);
+    let amount = 0.07 * (hi.x - lo.x);
     let mut moved = Vec::new();
-    let mut push = |q: Point3, degrees: f64, scale: f64| {
+    let mut push = |q: Point3, degrees: f64| {
         let a = degrees.to_radians();
         let weight = (degrees / 40.0 * std::f64::consts::FRAC_PI_2).cos();
         moved.push((
             nearest_vertex(p, q),
-            Point3::new(a.cos(), a.sin(), 0.0) * (amount * weight * scale),
+            Point3::new(a.cos(), a.sin(), 0.0) * (amount * weight),
         ));
     };
     for degrees in [-30.0, -15.0, 0.0, 15.0, 30.0] {
-        push(at(reach, degrees, 0.0), degrees, 1.0);
-    }
-    for degrees in [-20.0, 0.0, 20.0] {
-        push(at(reach - 2.0 * half, degrees, half), degrees, 0.8);
-        push(at(reach - 2.0 * half, degrees, -half), degrees, 0.8);
+        push(at(reach, degrees, 0.0), degrees);
     }
     let pinned = [150.0, 165.0, 180.0, 195.0, 210.0]
         .iter()
@@ -203,7 +199,7 @@ fn pull_rim(fit: &InitialFit) -> Scripted {
 }
 
 /// "Push a hole's rim up", as a user would drag it: eight points around the top rim of the hole
-/// furthest towards −x rise by the plate's half-thickness; four points on the same hole's bottom rim
+/// furthest towards −x rise by 60% of the plate's half-thickness; four points on the same hole's bottom rim
 /// and four around the other holes are pinned.
 fn push_hole(fit: &InitialFit) -> Scripted {
     let p = &fit.mesh.positions;
@@ -240,7 +236,7 @@ fn push_hole(fit: &InitialFit) -> Scripted {
     };
     let moved = ring(centres[k], half, 8)
         .into_iter()
-        .map(|i| (i, Point3::new(0.0, 0.0, half)))
+        .map(|i| (i, Point3::new(0.0, 0.0, 0.6 * half)))
         .collect();
     let mut pinned = ring(centres[k], -half, 4);
     for (j, &c) in centres.iter().enumerate() {
