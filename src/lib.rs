@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod cell_complex;
+pub mod editor;
 pub mod export;
 pub mod figures;
 pub mod files;

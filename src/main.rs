@@ -169,6 +169,35 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
+    /// Open the editor: a window to sculpt the surface by dragging its points.
+    ///
+    /// Opens MODEL (as written by `ntori new`), or fits the default genus-2 model when none is
+    /// given. Drag a point of the surface and the smallest change to the control points moves it
+    /// under the cursor (the paper's minimum-norm least squares); Ctrl + click pins points so they
+    /// stay put. Orbit with a left drag off the surface, pan with a right or middle drag, zoom with
+    /// the wheel; F frames the model, F1 lists every shortcut. Undo and redo, open, save, mesh
+    /// export and screenshots are in the menus. Unsaved work is autosaved to
+    /// $XDG_STATE_HOME/ntori (or ~/.local/state/ntori) and offered back after a crash.
+    ///
+    /// Needs a display and a GPU (or Mesa's software Vulkan, lavapipe).
+    ///
+    /// Examples:
+    ///   ntori edit                         the default genus-2 model
+    ///   ntori edit model.json --te 48 --tr 48
+    #[command(verbatim_doc_comment)]
+    Edit {
+        /// The model file to open.
+        #[arg(value_name = "MODEL")]
+        model: Option<std::path::PathBuf>,
+        /// Divisions of each edge chart's square (and each arc) in the viewport, 1 to 256.
+        #[arg(long, default_value_t = ntori::editor::state::DEFAULT_T, value_name = "A",
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(ntori::editor::state::MAX_T)))]
+        te: u32,
+        /// Divisions of each wheel spoke in the viewport, 1 to 256.
+        #[arg(long, default_value_t = ntori::editor::state::DEFAULT_T, value_name = "B",
+              value_parser = clap::value_parser!(u32).range(1..=i64::from(ntori::editor::state::MAX_T)))]
+        tr: u32,
+    },
     /// Export a model's surface as a triangle mesh: OBJ, PLY, STL, GLB or OFF.
     ///
     /// The surface is tessellated with the t_e/t_r scheme (see `ntori tessellate --help`; about
@@ -327,6 +356,18 @@ fn main() -> ExitCode {
     }
 }
 
+fn edit(model: Option<std::path::PathBuf>, te: u32, tr: u32) -> anyhow::Result<ExitCode> {
+    let loaded = model.as_deref().map(ntori::model_file::load).transpose()?;
+    let options = ntori::editor::EditorOptions {
+        model: loaded,
+        file: model,
+        tessellation: (te, tr),
+        ..Default::default()
+    };
+    ntori::editor::run(options).map_err(|e| anyhow::anyhow!("the editor failed: {e}"))?;
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Writes to stdout; a closed pipe (`ntori info | head`) is not an error.
 fn write_stdout(text: &str) -> anyhow::Result<()> {
     use std::io::Write as _;
@@ -426,6 +467,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(3)
             })
         }
+        Command::Edit { model, te, tr } => edit(model, te, tr),
         Command::Export {
             model,
             output,
@@ -435,6 +477,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             ascii,
             quiet,
         } => export(&model, &output, format, te, tr, ascii, quiet),
+        Command::Figures { out, quiet } => figures(&out, quiet),
         Command::Render {
             model,
             output,
@@ -463,7 +506,6 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             };
             render(&model, &output, &options, quiet)
         }
-        Command::Figures { out, quiet } => figures(&out, quiet),
         Command::Tessellate {
             genus: GenusArg { genus },
             te,

@@ -77,6 +77,40 @@ impl Stencil {
         acc
     }
 
+    /// Row r of W, W_u and W_v times `control` in one pass: the position and the first derivatives
+    /// S_u, S_v (in the row's own chart) of one surface point.
+    #[inline]
+    pub fn position_and_tangents(&self, control: &[Point3], r: usize) -> [Point3; 3] {
+        let (mut p, mut a, mut b) = (Point3::zeros(), Point3::zeros(), Point3::zeros());
+        for k in self.offsets[r]..self.offsets[r + 1] {
+            let c = control[self.controls[k] as usize];
+            p += c * self.pos[k];
+            a += c * self.du[k];
+            b += c * self.dv[k];
+        }
+        [p, a, b]
+    }
+
+    /// Row r's weights: each control point it uses with its weight and the weight's u and v
+    /// derivatives.
+    pub fn row(&self, r: usize) -> impl Iterator<Item = (u32, [f64; 3])> + '_ {
+        (self.offsets[r]..self.offsets[r + 1])
+            .map(move |k| (self.controls[k], [self.pos[k], self.du[k], self.dv[k]]))
+    }
+
+    /// Column `control` of W, W_u and W_v: each row that uses the control point, with the weight and
+    /// the weight's u and v derivatives.
+    pub fn column<'a>(
+        &'a self,
+        index: &'a ColumnIndex,
+        control: usize,
+    ) -> impl Iterator<Item = (u32, [f64; 3])> + 'a {
+        (index.offsets[control]..index.offsets[control + 1]).map(move |k| {
+            let e = index.entries[k];
+            (index.rows[k], [self.pos[e], self.du[e], self.dv[e]])
+        })
+    }
+
     /// The rows that control point `control` touches.
     pub fn rows_of<'a>(&self, index: &'a ColumnIndex, control: usize) -> &'a [u32] {
         &index.rows[index.offsets[control]..index.offsets[control + 1]]

@@ -1,0 +1,256 @@
+//! One drag: the minimum-norm edit that moves a picked surface point to the cursor while the pins
+//! stay, solved on every drag event, and the redraw of just the vertices it moves.
+//!
+//! Every event solves afresh from the control points the drag started with
+//! ([`embedding::edit::solve`]: the dragged point's constraint and one per pin, at the pins'
+//! positions when the drag began), so the result does not depend on how many events the pointer
+//! sent. The solution is linear in the dragged point's displacement Δ: the change is ΔP_c = β_c Δ
+//! for a fixed set of control points with fixed β (the constraint rows do not change during a
+//! drag). So at the start the plan also collects, for each vertex those control points reach, its
+//! position and tangents then and the gains g = Σ_c w_c β_c (and the same for the u and v
+//! derivative weights); an event then moves each such vertex to p₀ + g Δ and its tangents likewise,
+//! a few multiply-adds per vertex instead of its whole stencil row. When the drag ends, the moved
+//! rows are recomputed exactly from the stencil.
+//!
+//! The optional influence radius widens the edit: control points within the radius of the picked
+//! point first move by Δ times a smooth falloff (1 at the point, 0 at the radius), then the
+//! minimum-norm correction makes the dragged point and the pins exact again.
+
+use charts::ChartPoint;
+use embedding::edit::{Constraint, solve};
+use embedding::{EmbeddingError, Layout, Point3};
+
+use super::mesh::{LiveMesh, ViewVertex};
+
+/// A drag in progress.
+#[derive(Clone, Debug)]
+pub struct DragPlan {
+    /// The dragged surface point and where it was when the drag began.
+    pub point: ChartPoint,
+    pub start_position: Point3,
+    /// The pins as constraints (targets: where they were when the drag began).
+    pub pins: Vec<Constraint>,
+    /// The control points when the drag began.
+    pub start_control: Vec<Point3>,
+    /// Influence: control point and falloff weight.
+    soft: Vec<(u32, f64)>,
+    /// Every control point an event may move (sorted), and how: ΔP_c = beta_c Δ.
+    pub touched: Vec<u32>,
+    beta: Vec<f64>,
+    /// The vertices those control points reach (sorted), their position and tangents when the drag
+    /// began, and their gains.
+    pub rows: Vec<u32>,
+    base: Vec<[f32; 9]>,
+    gain: Vec<[f32; 3]>,
+    /// The displacement of the last event.
+    pub displacement: Point3,
+    /// The least-squares residual of the last solve (0 unless constraints conflict).
+    pub residual: f64,
+}
+
+impl DragPlan {
+    /// Plans a drag of `point` with `pins` held, from the current control points; `radius` (0: off)
+    /// is the influence radius in model units.
+    pub fn new(
+        layout: &Layout,
+        mesh: &mut LiveMesh,
+        control: &[Point3],
+        point: ChartPoint,
+        pins: &[ChartPoint],
+        radius: f64,
+    ) -> Result<DragPlan, EmbeddingError> {
+        let start_position = layout.eval(control, point).pos;
+        let pins: Vec<Constraint> = pins
+            .iter()
+            .map(|&p| Constraint {
+                point: p,
+                target: layout.eval(control, p).pos,
+            })
+            .collect();
+        let soft: Vec<(u32, f64)> = if radius > 0.0 {
+            control
+                .iter()
+                .enumerate()
+                .filter_map(|(c, q)| {
+                    let s = (q - start_position).norm() / radius;
+                    (s < 1.0).then(|| (c as u32, falloff(s)))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut plan = DragPlan {
+            point,
+            start_position,
+            pins,
+            start_control: control.to_vec(),
+            soft,
+            touched: Vec::new(),
+            beta: Vec::new(),
+            rows: Vec::new(),
+            base: Vec::new(),
+            gain: Vec::new(),
+            displacement: Point3::zeros(),
+            residual: 0.0,
+        };
+        // β by linearity: the change for a unit displacement along x.
+        let (moved, _) = plan.solve(layout, Point3::x())?;
+        let mut touched: Vec<(u32, f64)> = moved.iter().map(|(c, delta)| (*c, delta.x)).collect();
+        touched.sort_unstable_by_key(|t| t.0);
+        plan.touched = touched.iter().map(|t| t.0).collect();
+        plan.beta = touched.iter().map(|t| t.1).collect();
+        plan.rows = mesh.rows_of_controls(&plan.touched);
+        // Gains: scatter each touched column into its rows.
+        let mut slot = vec![u32::MAX; mesh.vertex_count()];
+        for (k, &r) in plan.rows.iter().enumerate() {
+            slot[r as usize] = k as u32;
+        }
+        let mut gain = vec![[0.0f64; 3]; plan.rows.len()];
+        for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
+            for (r, w) in mesh.stencil().column(mesh.columns(), c as usize) {
+                let g = &mut gain[slot[r as usize] as usize];
+                for a in 0..3 {
+                    g[a] += w[a] * b;
+                }
+            }
+        }
+        plan.gain = gain.iter().map(|g| g.map(|x| x as f32)).collect();
+        let (positions, tangents) = (mesh.positions(), mesh.tangents());
+        plan.base = plan
+            .rows
+            .iter()
+            .map(|&r| {
+                let (p, [u, v]) = (positions[r as usize], tangents[r as usize]);
+                [p.x, p.y, p.z, u.x, u.y, u.z, v.x, v.y, v.z].map(|x| x as f32)
+            })
+            .collect();
+        Ok(plan)
+    }
+
+    /// The minimum-norm change for displacement `delta` of the dragged point: (control point,
+    /// change) for every control point that moves, and the residual.
+    fn solve(
+        &self,
+        layout: &Layout,
+        delta: Point3,
+    ) -> Result<(Vec<(u32, Point3)>, f64), EmbeddingError> {
+        let mut start = std::borrow::Cow::Borrowed(&self.start_control);
+        if !self.soft.is_empty() {
+            let shifted = start.to_mut();
+            for &(c, f) in &self.soft {
+                shifted[c as usize] += delta * f;
+            }
+        }
+        let mut constraints = Vec::with_capacity(1 + self.pins.len());
+        constraints.push(Constraint {
+            point: self.point,
+            target: self.start_position + delta,
+        });
+        constraints.extend_from_slice(&self.pins);
+        let edit = solve(layout, &start, &constraints)?;
+        let mut moved: Vec<(u32, Point3)> =
+            self.soft.iter().map(|&(c, f)| (c, delta * f)).collect();
+        moved.extend(
+            edit.controls
+                .iter()
+                .copied()
+                .zip(edit.deltas.iter().copied()),
+        );
+        // Merge a control point that is both soft and corrected.
+        moved.sort_unstable_by_key(|m| m.0);
+        let mut merged: Vec<(u32, Point3)> = Vec::with_capacity(moved.len());
+        for (c, d) in moved {
+            match merged.last_mut() {
+                Some(last) if last.0 == c => last.1 += d,
+                _ => merged.push((c, d)),
+            }
+        }
+        Ok((merged, edit.residual))
+    }
+
+    /// One drag event: the dragged point's new target. Solves, writes the new control points into
+    /// `control` (start + change, for the touched ones), and moves the reached vertices in the GPU
+    /// copy (`vertices`, indexed by vertex). Returns the residual.
+    pub fn drag_to(
+        &mut self,
+        layout: &Layout,
+        target: Point3,
+        control: &mut [Point3],
+        vertices: &mut [ViewVertex],
+    ) -> Result<f64, EmbeddingError> {
+        let delta = target - self.start_position;
+        let (moved, residual) = self.solve(layout, delta)?;
+        for &c in &self.touched {
+            control[c as usize] = self.start_control[c as usize];
+        }
+        for (c, d) in moved {
+            control[c as usize] = self.start_control[c as usize] + d;
+        }
+        self.displacement = delta;
+        self.residual = residual;
+        self.move_vertices(delta, vertices);
+        Ok(residual)
+    }
+
+    /// The vertices' new positions and normals for displacement `delta` (sorted rows, so the
+    /// vertex array splits into disjoint pieces, one per thread).
+    pub fn move_vertices(&self, delta: Point3, vertices: &mut [ViewVertex]) {
+        let d = [delta.x as f32, delta.y as f32, delta.z as f32];
+        let work = |first: usize, rows: &[u32], out: &mut [ViewVertex], offset: usize| {
+            for (k, &r) in (first..).zip(rows) {
+                let (b, g) = (&self.base[k], &self.gain[k]);
+                let p = [b[0] + g[0] * d[0], b[1] + g[0] * d[1], b[2] + g[0] * d[2]];
+                let u = [b[3] + g[1] * d[0], b[4] + g[1] * d[1], b[5] + g[1] * d[2]];
+                let v = [b[6] + g[2] * d[0], b[7] + g[2] * d[1], b[8] + g[2] * d[2]];
+                let n = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                let inv = 1.0 / (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                let vertex = &mut out[r as usize - offset];
+                vertex.position = p;
+                vertex.normal = n.map(|x| x * inv);
+            }
+        };
+        split_by_rows(&self.rows, vertices, work);
+    }
+}
+
+/// Splits sorted rows into per-thread chunks and the vertex array at the chunk borders, so each
+/// thread writes its own piece: `work(index of the chunk's first row, rows, piece, piece offset)`.
+fn split_by_rows(
+    rows: &[u32],
+    vertices: &mut [ViewVertex],
+    work: impl Fn(usize, &[u32], &mut [ViewVertex], usize) + Sync,
+) {
+    const MIN_PER_THREAD: usize = 16_384;
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(rows.len().div_ceil(MIN_PER_THREAD))
+        .max(1);
+    if threads == 1 {
+        work(0, rows, vertices, 0);
+        return;
+    }
+    let per = rows.len().div_ceil(threads);
+    std::thread::scope(|scope| {
+        let mut rest = vertices;
+        let mut offset = 0usize;
+        for (i, chunk) in rows.chunks(per).enumerate() {
+            let end = chunk.last().map_or(offset, |&r| r as usize + 1);
+            let (mine, tail) = std::mem::take(&mut rest).split_at_mut(end - offset);
+            rest = tail;
+            let work = &work;
+            let start = offset;
+            scope.spawn(move || work(i * per, chunk, mine, start));
+            offset = end;
+        }
+    });
+}
+
+/// A smooth falloff on [0, 1]: 1 at 0, 0 at 1, flat at both ends ((1 − s²)³).
+pub fn falloff(s: f64) -> f64 {
+    let t = (1.0 - s * s).max(0.0);
+    t * t * t
+}

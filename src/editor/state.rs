@@ -1,0 +1,641 @@
+//! The editor's state, apart from any drawing: the document (genus, spline settings, control points,
+//! its file), the live mesh, the camera, picking, pins, the drag in progress and the history. The
+//! egui code (`app.rs`) turns input into calls here; the tests drive the same calls.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
+use embedding::fit::{FitSettings, vertex_areas};
+use embedding::{EmbeddingError, Layout, Model, Point3, SplineSettings};
+
+use super::camera::{OrbitCamera, to_point};
+use super::drag::DragPlan;
+use super::history::{Change, History};
+use super::mesh::LiveMesh;
+use super::pick::Hit;
+use crate::model_file::{self, ModelFileError};
+use crate::render::Style;
+
+/// What can go wrong in the editor.
+#[derive(Debug, thiserror::Error)]
+pub enum EditorError {
+    #[error(transparent)]
+    Model(#[from] EmbeddingError),
+    #[error(transparent)]
+    Charts(#[from] charts::ChartsError),
+    #[error(transparent)]
+    File(#[from] ModelFileError),
+    #[error(transparent)]
+    Export(#[from] crate::export::ExportError),
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    #[error(transparent)]
+    Io(#[from] crate::files::FileError),
+    #[error("t_e = {te}, t_r = {tr} is out of the editor's range (1 to {max} each)")]
+    Tessellation { te: u32, tr: u32, max: u32 },
+    #[error("{0}")]
+    Other(String),
+}
+
+/// The largest t_e or t_r the editor offers (about 1.3 million vertices at genus 2).
+pub const MAX_T: u32 = 256;
+/// The default tessellation: smooth at genus 2 (about 20 000 vertices), quick at any genus.
+pub const DEFAULT_T: u32 = 32;
+
+/// A picked surface point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pick {
+    /// The triangle the ray hit, the barycentric coordinates of the hit and the ray parameter.
+    pub hit: Hit,
+    /// The manifold point there: the barycentric combination of the triangle's corners in its home
+    /// chart, with every chart that holds it.
+    pub point: ChartPoint,
+    pub manifold: ManifoldPoint,
+    /// Where the ray met the triangle, and the exact surface point S(point).
+    pub on_mesh: Point3,
+    pub surface: Point3,
+}
+
+/// What a press in the viewport grabbed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Grab {
+    /// A surface point (not pinned).
+    Surface,
+    /// The pin with this index.
+    Pin(usize),
+}
+
+/// A drag in progress: the plan and where the pointer went down.
+#[derive(Clone, Debug)]
+pub struct Drag {
+    pub plan: DragPlan,
+    pub press_pixel: [f64; 2],
+    pub grab: Grab,
+    pub events: u32,
+    /// Time spent in drag events (solve and vertex update), in total and the last one.
+    pub busy: Duration,
+    pub last: Duration,
+}
+
+/// The last finished drag: what moved where, and how long its events took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DragStats {
+    /// The dragged surface point, where it was, and where the last event asked it to go.
+    pub point: ChartPoint,
+    pub start: Point3,
+    pub target: Point3,
+    pub events: u32,
+    pub mean: Duration,
+    pub last: Duration,
+    /// Vertices each event moved and control points it changed.
+    pub vertices: usize,
+    pub controls: usize,
+}
+
+/// The editor's state (see the module documentation).
+pub struct EditorState {
+    atlas: Atlas,
+    settings: SplineSettings,
+    control: Vec<Point3>,
+    mesh: LiveMesh,
+    te: u32,
+    tr: u32,
+    pub camera: OrbitCamera,
+    /// The viewport's size in physical pixels.
+    pub viewport: [f64; 2],
+    pins: Vec<ChartPoint>,
+    drag: Option<Drag>,
+    history: History,
+    path: Option<PathBuf>,
+    saved_state: u64,
+    /// The influence radius as a fraction of the model's size (0: off, the paper's edit).
+    pub influence: f64,
+    /// Whose control points to show.
+    pub control_chart: Option<ChartId>,
+    pub last_drag: Option<DragStats>,
+}
+
+impl EditorState {
+    /// A state for `model`, tessellated at t_e, t_r, with the default view.
+    pub fn new(model: &Model, te: u32, tr: u32) -> Result<EditorState, EditorError> {
+        check_t(te, tr)?;
+        let atlas = Atlas::new(model.genus)?;
+        let layout = Layout::new(&atlas, model.settings)?;
+        model.validate(&layout)?;
+        let control = model.points();
+        let mesh = LiveMesh::new(&layout, &control, te, tr, Style::Shaded)?;
+        let (centre, radius) = mesh.bounding_sphere();
+        Ok(EditorState {
+            settings: model.settings,
+            camera: OrbitCamera::new(centre, radius),
+            viewport: [800.0, 600.0],
+            control,
+            mesh,
+            te,
+            tr,
+            atlas,
+            pins: Vec::new(),
+            drag: None,
+            history: History::new(),
+            path: None,
+            saved_state: 0,
+            influence: 0.0,
+            control_chart: None,
+            last_drag: None,
+        })
+    }
+
+    /// Opens a model file.
+    pub fn open(path: &Path, te: u32, tr: u32) -> Result<EditorState, EditorError> {
+        let model = model_file::load(path)?;
+        let mut state = EditorState::new(&model, te, tr)?;
+        state.path = Some(path.to_owned());
+        Ok(state)
+    }
+
+    /// Writes the model to `path` and makes it the document's file.
+    pub fn save(&mut self, path: &Path) -> Result<(), EditorError> {
+        model_file::save(path, &self.model())?;
+        self.path = Some(path.to_owned());
+        self.saved_state = self.history.state();
+        Ok(())
+    }
+
+    /// The model as it stands.
+    pub fn model(&self) -> Model {
+        match Layout::new(&self.atlas, self.settings) {
+            Ok(layout) => Model::from_points(&layout, &self.control),
+            // The settings were checked when they were set.
+            Err(_) => unreachable!("checked spline settings"),
+        }
+    }
+
+    pub fn layout(&self) -> Layout<'_> {
+        Layout::new(&self.atlas, self.settings).unwrap_or_else(|_| unreachable!("checked settings"))
+    }
+
+    pub fn atlas(&self) -> &Atlas {
+        &self.atlas
+    }
+    pub fn genus(&self) -> u32 {
+        self.atlas.genus()
+    }
+    pub fn settings(&self) -> SplineSettings {
+        self.settings
+    }
+    pub fn control(&self) -> &[Point3] {
+        &self.control
+    }
+    pub fn mesh(&self) -> &LiveMesh {
+        &self.mesh
+    }
+    pub fn mesh_mut(&mut self) -> &mut LiveMesh {
+        &mut self.mesh
+    }
+    pub fn tessellation(&self) -> (u32, u32) {
+        (self.te, self.tr)
+    }
+    pub fn style(&self) -> Style {
+        self.mesh.style()
+    }
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+    pub fn set_path(&mut self, path: Option<PathBuf>) {
+        self.path = path;
+    }
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+    /// Unsaved changes?
+    pub fn is_modified(&self) -> bool {
+        self.history.state() != self.saved_state
+    }
+    /// Marks the document as changed since its file (e.g. recovered after a crash).
+    pub fn mark_modified(&mut self) {
+        self.saved_state = u64::MAX;
+    }
+    pub fn pins(&self) -> &[ChartPoint] {
+        &self.pins
+    }
+    pub fn drag(&self) -> Option<&Drag> {
+        self.drag.as_ref()
+    }
+
+    /// The model's size: the diagonal of the tessellation's bounding box.
+    pub fn size(&self) -> f64 {
+        self.mesh.size()
+    }
+
+    /// The exact surface point at a chart point.
+    pub fn surface_point(&self, p: ChartPoint) -> Point3 {
+        self.layout().eval(&self.control, p).pos
+    }
+
+    // ------------------------------------------------------------------------------- display
+
+    pub fn set_style(&mut self, style: Style) {
+        if style != self.mesh.style() {
+            let layout = Layout::new(&self.atlas, self.settings)
+                .unwrap_or_else(|_| unreachable!("checked settings"));
+            self.mesh.set_style(&layout, &self.control, style);
+        }
+    }
+
+    /// Tessellates anew at t_e, t_r (the view stays).
+    pub fn set_tessellation(&mut self, te: u32, tr: u32) -> Result<(), EditorError> {
+        check_t(te, tr)?;
+        if (te, tr) == (self.te, self.tr) {
+            return Ok(());
+        }
+        let layout = self.layout();
+        let mesh = LiveMesh::new(&layout, &self.control, te, tr, self.mesh.style())?;
+        self.mesh = mesh;
+        (self.te, self.tr) = (te, tr);
+        Ok(())
+    }
+
+    /// Centres the model and fits it in the view.
+    pub fn frame(&mut self) {
+        self.update_scene();
+        self.camera.frame(self.viewport[0] / self.viewport[1]);
+    }
+
+    /// The default view of the model.
+    pub fn reset_view(&mut self) {
+        self.update_scene();
+        self.camera.reset();
+    }
+
+    fn update_scene(&mut self) {
+        let (centre, radius) = self.mesh.bounding_sphere();
+        self.camera.set_scene(centre, radius);
+    }
+
+    // ------------------------------------------------------------------------------- picking
+
+    /// The surface point under a pixel of the viewport, if any.
+    pub fn pick(&mut self, pixel: [f64; 2]) -> Option<Pick> {
+        if self.drag.is_some() {
+            return None;
+        }
+        let ray = self.camera.ray(pixel, self.viewport);
+        let hit = self.mesh.cast(&ray)?;
+        let point = hit.chart_point(&self.mesh.tessellation);
+        let manifold = self.atlas.locate(point).ok()?;
+        Some(Pick {
+            hit,
+            point,
+            manifold,
+            on_mesh: ray.at(hit.t),
+            surface: self.surface_point(point),
+        })
+    }
+
+    /// The pin drawn within `radius` pixels of `pixel` (nearest first), if any.
+    pub fn pin_near(&self, pixel: [f64; 2], radius: f64) -> Option<usize> {
+        self.pins
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| {
+                let (q, depth) = self.camera.project(self.surface_point(p), self.viewport);
+                (i, (q[0] - pixel[0]).hypot(q[1] - pixel[1]), depth)
+            })
+            .filter(|&(_, d, depth)| d <= radius && depth > 0.0)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _, _)| i)
+    }
+
+    /// Pins the surface point under `pixel`, or unpins the pin there. Returns whether anything
+    /// changed.
+    pub fn toggle_pin(&mut self, pixel: [f64; 2]) -> bool {
+        if let Some(i) = self.pin_near(pixel, PIN_RADIUS_PX) {
+            self.pins.remove(i);
+            return true;
+        }
+        match self.pick(pixel) {
+            Some(pick) => {
+                self.pins.push(pick.point);
+                true
+            }
+            None => false,
+        }
+    }
+
+    pub fn add_pin(&mut self, point: ChartPoint) {
+        self.pins.push(point);
+    }
+    pub fn remove_pin(&mut self, i: usize) {
+        if i < self.pins.len() {
+            self.pins.remove(i);
+        }
+    }
+    pub fn clear_pins(&mut self) {
+        self.pins.clear();
+    }
+
+    // ------------------------------------------------------------------------------- dragging
+
+    /// Starts a drag at `pixel`: grabs a pin drawn there, or else the surface point under it.
+    /// Returns what was grabbed (None: nothing there, e.g. to orbit instead).
+    pub fn press(&mut self, pixel: [f64; 2]) -> Result<Option<Grab>, EditorError> {
+        if self.drag.is_some() {
+            return Ok(None);
+        }
+        let (point, grab) = if let Some(i) = self.pin_near(pixel, PIN_RADIUS_PX) {
+            (self.pins[i], Grab::Pin(i))
+        } else if let Some(pick) = self.pick(pixel) {
+            (pick.point, Grab::Surface)
+        } else {
+            return Ok(None);
+        };
+        self.start_drag(point, grab, pixel)?;
+        Ok(Some(grab))
+    }
+
+    /// Starts a drag of `point` (the pointer is at `pixel`).
+    pub fn start_drag(
+        &mut self,
+        point: ChartPoint,
+        grab: Grab,
+        pixel: [f64; 2],
+    ) -> Result<(), EditorError> {
+        let pins: Vec<ChartPoint> = self
+            .pins
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| grab != Grab::Pin(i))
+            .map(|(_, &p)| p)
+            .collect();
+        let radius = self.influence * self.size();
+        let layout = Layout::new(&self.atlas, self.settings)?;
+        let plan = DragPlan::new(&layout, &mut self.mesh, &self.control, point, &pins, radius)?;
+        self.drag = Some(Drag {
+            plan,
+            press_pixel: pixel,
+            grab,
+            events: 0,
+            busy: Duration::ZERO,
+            last: Duration::ZERO,
+        });
+        Ok(())
+    }
+
+    /// Where a drag that pressed at `press` and is now at `pixel` wants its point: the start
+    /// position moved by the pointer's motion in the plane through it facing the camera.
+    pub fn drag_target(&self, anchor: Point3, press: [f64; 2], pixel: [f64; 2]) -> Point3 {
+        let (a, b) = (
+            self.camera.on_view_plane(press, self.viewport, anchor),
+            self.camera.on_view_plane(pixel, self.viewport, anchor),
+        );
+        anchor + (b - a)
+    }
+
+    /// A drag event: the pointer is at `pixel`. Solves and moves the affected vertices.
+    pub fn drag_to(&mut self, pixel: [f64; 2]) -> Result<(), EditorError> {
+        let Some(drag) = &self.drag else {
+            return Ok(());
+        };
+        let target = self.drag_target(drag.plan.start_position, drag.press_pixel, pixel);
+        self.drag_to_target(target)
+    }
+
+    /// A drag event with an explicit target for the dragged point.
+    pub fn drag_to_target(&mut self, target: Point3) -> Result<(), EditorError> {
+        let Some(drag) = &mut self.drag else {
+            return Ok(());
+        };
+        let started = Instant::now();
+        let layout = Layout::new(&self.atlas, self.settings)?;
+        drag.plan
+            .drag_to(&layout, target, &mut self.control, self.mesh.vertices_mut())?;
+        self.mesh.mark_dirty(&drag.plan.rows);
+        let took = started.elapsed();
+        drag.events += 1;
+        drag.busy += took;
+        drag.last = took;
+        Ok(())
+    }
+
+    /// Ends the drag: the moved vertices are recomputed exactly and the change joins the history.
+    pub fn release(&mut self) {
+        let Some(drag) = self.drag.take() else {
+            return;
+        };
+        let plan = drag.plan;
+        let moved: Vec<u32> = plan
+            .touched
+            .iter()
+            .copied()
+            .filter(|&c| self.control[c as usize] != plan.start_control[c as usize])
+            .collect();
+        let layout = Layout::new(&self.atlas, self.settings)
+            .unwrap_or_else(|_| unreachable!("checked settings"));
+        self.mesh.recompute_rows(&self.control, &plan.rows);
+        if matches!(self.mesh.style(), Style::Curvature(_)) {
+            self.mesh.controls_changed(&layout, &self.control, &moved);
+        }
+        self.last_drag = Some(DragStats {
+            point: plan.point,
+            start: plan.start_position,
+            target: plan.start_position + plan.displacement,
+            events: drag.events,
+            mean: drag.busy / drag.events.max(1),
+            last: drag.last,
+            vertices: plan.rows.len(),
+            controls: plan.touched.len(),
+        });
+        if moved.is_empty() {
+            return;
+        }
+        let label = match drag.grab {
+            Grab::Surface => "drag",
+            Grab::Pin(_) => "drag pin",
+        };
+        self.history.push(
+            label,
+            Change::Controls {
+                before: moved
+                    .iter()
+                    .map(|&c| plan.start_control[c as usize])
+                    .collect(),
+                after: moved.iter().map(|&c| self.control[c as usize]).collect(),
+                indices: moved,
+            },
+        );
+    }
+
+    /// Abandons the drag: the control points go back to where they were.
+    pub fn cancel_drag(&mut self) {
+        let Some(drag) = self.drag.take() else {
+            return;
+        };
+        for &c in &drag.plan.touched {
+            self.control[c as usize] = drag.plan.start_control[c as usize];
+        }
+        self.mesh.recompute_rows(&self.control, &drag.plan.rows);
+    }
+
+    // ------------------------------------------------------------------------------- history
+
+    pub fn can_undo(&self) -> bool {
+        self.drag.is_none() && self.history.can_undo()
+    }
+    pub fn can_redo(&self) -> bool {
+        self.drag.is_none() && self.history.can_redo()
+    }
+
+    /// Reverts the last change. Returns its label.
+    pub fn undo(&mut self) -> Result<Option<String>, EditorError> {
+        if self.drag.is_some() {
+            return Ok(None);
+        }
+        let Some(entry) = self.history.undo() else {
+            return Ok(None);
+        };
+        let (label, change) = (entry.label.clone(), entry.change.clone());
+        self.apply(&change, false)?;
+        Ok(Some(label))
+    }
+
+    /// Applies the last undone change again. Returns its label.
+    pub fn redo(&mut self) -> Result<Option<String>, EditorError> {
+        if self.drag.is_some() {
+            return Ok(None);
+        }
+        let Some(entry) = self.history.redo() else {
+            return Ok(None);
+        };
+        let (label, change) = (entry.label.clone(), entry.change.clone());
+        self.apply(&change, true)?;
+        Ok(Some(label))
+    }
+
+    fn apply(&mut self, change: &Change, forward: bool) -> Result<(), EditorError> {
+        match change {
+            Change::Controls {
+                indices,
+                before,
+                after,
+            } => {
+                let values = if forward { after } else { before };
+                for (&c, v) in indices.iter().zip(values) {
+                    self.control[c as usize] = *v;
+                }
+                let layout = Layout::new(&self.atlas, self.settings)?;
+                self.mesh.controls_changed(&layout, &self.control, indices);
+            }
+            Change::Settings { before, after } => {
+                let (settings, control) = if forward { after } else { before };
+                self.replace_control(*settings, control.clone())?;
+            }
+        }
+        Ok(())
+    }
+
+    /// New spline settings with their control points (e.g. from [`refit`]): an undoable change.
+    pub fn set_settings(
+        &mut self,
+        settings: SplineSettings,
+        control: Vec<Point3>,
+    ) -> Result<(), EditorError> {
+        let before = (self.settings, self.control.clone());
+        self.replace_control(settings, control.clone())?;
+        self.history.push(
+            format!(
+                "settings: degree {}, C^{}, grid {}",
+                settings.degree, settings.continuity, settings.grid
+            ),
+            Change::Settings {
+                before,
+                after: (settings, control),
+            },
+        );
+        Ok(())
+    }
+
+    fn replace_control(
+        &mut self,
+        settings: SplineSettings,
+        control: Vec<Point3>,
+    ) -> Result<(), EditorError> {
+        let layout = Layout::new(&self.atlas, settings)?;
+        Model::from_points(&layout, &control).validate(&layout)?;
+        let mesh = LiveMesh::new(&layout, &control, self.te, self.tr, self.mesh.style())?;
+        self.settings = settings;
+        self.control = control;
+        self.mesh = mesh;
+        if let Some(c) = self.control_chart
+            && c.index() >= self.atlas.charts().len()
+        {
+            self.control_chart = None;
+        }
+        Ok(())
+    }
+
+    /// The control points of one chart, as a grid × grid net (row j, column i at j·grid + i).
+    pub fn control_net(&self, chart: ChartId) -> &[Point3] {
+        let g = self.settings.grid;
+        let start = chart.index() * g * g;
+        &self.control[start..(start + g * g).min(self.control.len())]
+    }
+
+    /// Where a viewport pixel's ray meets the surface, as text for the status bar.
+    pub fn describe(&self, pick: &Pick) -> String {
+        let p = pick.point;
+        format!(
+            "chart {} at ({:.4}, {:.4}), S = ({:.4}, {:.4}, {:.4})",
+            p.chart.0, p.coords.re, p.coords.im, pick.surface.x, pick.surface.y, pick.surface.z
+        )
+    }
+
+    /// The camera's eye, in model coordinates.
+    pub fn eye(&self) -> Point3 {
+        to_point(self.camera.eye())
+    }
+}
+
+/// How close (in pixels) a press must be to a pin to grab it.
+pub const PIN_RADIUS_PX: f64 = 7.0;
+
+fn check_t(te: u32, tr: u32) -> Result<(), EditorError> {
+    if !(1..=MAX_T).contains(&te) || !(1..=MAX_T).contains(&tr) {
+        return Err(EditorError::Tessellation { te, tr, max: MAX_T });
+    }
+    Ok(())
+}
+
+/// A model's control points for other spline settings: the new layout fitted (least squares, as the
+/// initial fit does) to the current surface sampled at a tessellation's vertices. Returns the
+/// control points and the largest distance between the two surfaces at the samples.
+pub fn refit(model: &Model, settings: SplineSettings) -> Result<(Vec<Point3>, f64), EditorError> {
+    let atlas = Atlas::new(model.genus)?;
+    let old = Layout::new(&atlas, model.settings)?;
+    model.validate(&old)?;
+    let new = Layout::new(&atlas, settings)?;
+    // About four samples per control point along each side of a chart.
+    let t = (2 * settings.grid.max(model.settings.grid)).clamp(16, 96) as u32;
+    let tessellation = atlas.tessellate(t, t)?;
+    let control = model.points();
+    let stencil = embedding::Stencil::build(&old, &tessellation.vertices);
+    let mut targets = vec![Point3::zeros(); stencil.rows()];
+    stencil.positions(&control, &mut targets);
+    let weights = vertex_areas(&targets, &tessellation.triangles);
+    let fitted = embedding::fit::fit(
+        &new,
+        &tessellation.vertices,
+        &targets,
+        &weights,
+        FitSettings::default(),
+    )?;
+    let check = embedding::Stencil::build(&new, &tessellation.vertices);
+    let mut now = vec![Point3::zeros(); check.rows()];
+    check.positions(&fitted, &mut now);
+    let worst = now
+        .iter()
+        .zip(&targets)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    Ok((fitted, worst))
+}

@@ -1,0 +1,449 @@
+//! The editor, driven through its window by egui_kittest (real input events into the real app,
+//! rendered on wgpu — lavapipe on machines without a GPU): picking, dragging with pins, undo and
+//! redo, save and open, the unsaved-changes prompt, crash recovery. A screenshot after a scripted
+//! drag is written under the target directory (the test prints where).
+
+use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+use charts::ChartPoint;
+use egui::{Event, Key, Modifiers, PointerButton, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable as _;
+use embedding::fit::{FitSettings, initial_model};
+use embedding::{Model, Point3, SplineSettings};
+use ntori::editor::camera::Ray;
+use ntori::editor::pick::cast_all;
+use ntori::editor::recovery::{RECOVERY_FORMAT, Recovery, RecoveryFile};
+use ntori::editor::{EditorApp, EditorOptions};
+
+/// The default genus-2 model, fitted once for all tests.
+fn model() -> &'static Model {
+    static MODEL: OnceLock<Model> = OnceLock::new();
+    MODEL.get_or_init(|| {
+        initial_model(2, 32, SplineSettings::default(), FitSettings::default())
+            .expect("the default model fits")
+            .model
+    })
+}
+
+/// One harness at a time: each opens a wgpu device, and lavapipe shares the machine's cores.
+fn gpu_lock() -> MutexGuard<'static, ()> {
+    static LOCK: Mutex<()> = Mutex::new(());
+    LOCK.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn harness_with(options: EditorOptions) -> Harness<'static, EditorApp> {
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1100.0, 720.0))
+        .wgpu()
+        .build_eframe(move |cc| EditorApp::new(cc, options));
+    harness.run_steps(3);
+    harness
+}
+
+fn harness() -> Harness<'static, EditorApp> {
+    harness_with(EditorOptions {
+        model: Some(model().clone()),
+        file: None,
+        recovery_dir: None,
+        tessellation: (24, 24),
+    })
+}
+
+/// The egui position of a viewport pixel.
+fn pos_of(app: &EditorApp, pixel: [f64; 2]) -> Pos2 {
+    let rect = app.viewport_rect();
+    let state = app.state().unwrap();
+    Pos2::new(
+        rect.min.x + (pixel[0] * f64::from(rect.width()) / state.viewport[0]) as f32,
+        rect.min.y + (pixel[1] * f64::from(rect.height()) / state.viewport[1]) as f32,
+    )
+}
+
+/// The viewport pixel of an egui position (as the app maps it).
+fn pixel_of(app: &EditorApp, pos: Pos2) -> [f64; 2] {
+    let rect = app.viewport_rect();
+    let state = app.state().unwrap();
+    [
+        f64::from(pos.x - rect.min.x) * state.viewport[0] / f64::from(rect.width()),
+        f64::from(pos.y - rect.min.y) * state.viewport[1] / f64::from(rect.height()),
+    ]
+}
+
+/// A tessellation vertex that the camera sees (its own triangles are the first the ray through it
+/// meets), near the given fraction of the viewport. Returns the vertex index and its pixel.
+fn visible_vertex(app: &mut EditorApp, at: [f64; 2]) -> (usize, [f64; 2]) {
+    let state = app.state_mut().unwrap();
+    let size = state.viewport;
+    let goal = [at[0] * size[0], at[1] * size[1]];
+    let mesh = state.mesh();
+    let mut candidates: Vec<(f64, usize, [f64; 2])> = mesh
+        .positions()
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &p)| {
+            let (q, depth) = state.camera.project(p, size);
+            (depth > 0.0).then(|| ((q[0] - goal[0]).hypot(q[1] - goal[1]), k, q))
+        })
+        .collect();
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for &(_, k, q) in candidates.iter().take(50) {
+        let ray = state.camera.ray(q, size);
+        let hit = cast_all(&ray, mesh.positions(), &mesh.tessellation.triangles).unwrap();
+        if (ray.at(hit.t) - mesh.positions()[k]).norm() < 1e-9 * state.size() {
+            return (k, q);
+        }
+    }
+    panic!("no visible vertex near {at:?}");
+}
+
+fn same_point(app: &EditorApp, a: ChartPoint, b: ChartPoint) -> f64 {
+    let state = app.state().unwrap();
+    let b_in_a = state.atlas().locate(b).unwrap().in_chart(a.chart).unwrap();
+    (b_in_a - a.coords).norm()
+}
+
+fn command_click(harness: &mut Harness<'static, EditorApp>, pos: Pos2) {
+    harness.event(Event::ModifiersChanged(Modifiers::COMMAND));
+    harness.event(Event::PointerMoved(pos));
+    harness.step();
+    harness.event(Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed: true,
+        modifiers: Modifiers::COMMAND,
+    });
+    harness.step();
+    harness.event(Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed: false,
+        modifiers: Modifiers::COMMAND,
+    });
+    harness.step();
+    harness.event(Event::ModifiersChanged(Modifiers::NONE));
+    harness.step();
+}
+
+fn artefact_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("editor");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn a_pick_at_a_known_pixel_returns_that_manifold_point() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    for at in [[0.5, 0.5], [0.35, 0.6], [0.62, 0.42]] {
+        let (k, pixel) = visible_vertex(harness.state_mut(), at);
+        let pos = pos_of(harness.state(), pixel);
+        harness.hover_at(pos);
+        harness.run();
+        let app = harness.state();
+        let pick = app
+            .hover()
+            .expect("the pointer is over the surface")
+            .clone();
+        let vertex = app.state().unwrap().mesh().tessellation.vertices[k];
+        // The same manifold point, up to the pointer's f32 position.
+        let off = same_point(app, pick.point, vertex);
+        assert!(
+            off < 1e-5,
+            "picked {:?}, expected {vertex:?} ({off:e})",
+            pick.point
+        );
+        // Exactly the brute-force hit of the same ray: same triangle, same barycentrics.
+        let state = app.state().unwrap();
+        let ray: Ray = state.camera.ray(pixel_of(app, pos), state.viewport);
+        let mesh = state.mesh();
+        let brute = cast_all(&ray, mesh.positions(), &mesh.tessellation.triangles).unwrap();
+        assert_eq!(brute.triangle, pick.hit.triangle);
+        for a in 0..3 {
+            assert!((brute.bary[a] - pick.hit.bary[a]).abs() < 1e-12);
+        }
+        // The chart point is the barycentric combination of the triangle's corners, and every
+        // representation of the manifold point is the same surface point.
+        let corners = mesh.tessellation.triangle_coords[pick.hit.triangle as usize];
+        let combined: num_complex::Complex64 =
+            corners.iter().zip(pick.hit.bary).map(|(c, b)| c * b).sum();
+        assert!((combined - pick.point.coords).norm() < 1e-15);
+        for &rep in pick.manifold.representations() {
+            assert!((state.surface_point(rep) - pick.surface).norm() < 1e-9);
+        }
+        // The exact surface is within the tessellation's chord error of the ray's hit.
+        assert!((pick.surface - pick.on_mesh).norm() < 1e-2 * state.size());
+    }
+}
+
+#[test]
+fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+
+    // Two pins by Ctrl + click, away from the drag.
+    let mut pins = Vec::new();
+    for at in [[0.3, 0.45], [0.72, 0.55]] {
+        let (_, pixel) = visible_vertex(harness.state_mut(), at);
+        let pos = pos_of(harness.state(), pixel);
+        command_click(&mut harness, pos);
+        pins.push(pixel);
+    }
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.pins().len(), 2, "Ctrl + click pins");
+    let pinned: Vec<(ChartPoint, Point3)> = state
+        .pins()
+        .iter()
+        .map(|&p| (p, state.surface_point(p)))
+        .collect();
+    let before = state.control().to_vec();
+
+    // Drag a point near the middle by N pixels, in several events.
+    let (_, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    let start = pos_of(harness.state(), pixel);
+    let shift = Vec2::new(40.0, -25.0);
+    harness.hover_at(start);
+    harness.step();
+    harness.drag_at(start);
+    harness.step();
+    for i in 1..=8 {
+        harness.hover_at(start + shift * (i as f32 / 8.0));
+        harness.step();
+    }
+    let end = start + shift;
+    harness.drop_at(end);
+    harness.step();
+    harness.run();
+
+    let app = harness.state();
+    let state = app.state().unwrap();
+    let drag = state.last_drag.expect("a drag happened");
+    assert!(drag.events >= 2, "{} drag events", drag.events);
+    // The target, independently: the start point moved by the pointer's motion, in the plane
+    // through it facing the camera.
+    let size = state.viewport;
+    let normal = {
+        let d = state.camera.direction();
+        Point3::new(d.x, d.y, d.z)
+    };
+    let on_plane = |pixel: [f64; 2]| {
+        let ray = state.camera.ray(pixel, size);
+        ray.at((drag.start - ray.origin).dot(&normal) / ray.direction.dot(&normal))
+    };
+    let target = drag.start + (on_plane(pixel_of(app, end)) - on_plane(pixel_of(app, start)));
+    let moved = state.surface_point(drag.point);
+    let model_size = state.size();
+    assert!(
+        (moved - target).norm() < 1e-6 * model_size,
+        "the dragged point is {:e} from its target (model size {model_size})",
+        (moved - target).norm()
+    );
+    assert!(
+        (moved - drag.start).norm() > 1e-2 * model_size,
+        "the drag moved the surface"
+    );
+    // It is where the cursor is.
+    let (seen, _) = state.camera.project(moved, size);
+    let cursor = pixel_of(app, end);
+    assert!((seen[0] - cursor[0]).hypot(seen[1] - cursor[1]) < 1e-3);
+    for (p, was) in &pinned {
+        let now = state.surface_point(*p);
+        assert!(
+            (now - was).norm() < 1e-9,
+            "a pin moved by {:e}",
+            (now - was).norm()
+        );
+    }
+    // The redraw: every vertex equals its stencil row, and the GPU copy agrees (f32).
+    let mesh = state.mesh();
+    let mut full = vec![Point3::zeros(); mesh.vertex_count()];
+    mesh.stencil().positions(state.control(), &mut full);
+    for (k, (a, b)) in mesh.positions().iter().zip(&full).enumerate() {
+        assert!((a - b).norm() <= 1e-12 * model_size, "vertex {k}");
+        let v = mesh.vertices()[k].position;
+        assert!(
+            (Point3::new(v[0].into(), v[1].into(), v[2].into()) - b).norm() < 1e-5 * model_size
+        );
+    }
+    let after = state.control().to_vec();
+    assert_ne!(before, after);
+    assert!(state.is_modified());
+
+    // A screenshot of the whole window after the drag, kept as an artefact.
+    let image = harness.render().expect("the window renders");
+    let path = artefact_dir().join("after-drag.png");
+    image.save(&path).unwrap();
+    println!("screenshot after the drag: {}", path.display());
+
+    // Undo restores the control points exactly; redo reapplies them.
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run();
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.control(), &before[..], "undo is exact");
+    assert!(!state.is_modified(), "back at the saved state");
+    let mut full = vec![Point3::zeros(); state.mesh().vertex_count()];
+    state.mesh().stencil().positions(state.control(), &mut full);
+    assert!(
+        state
+            .mesh()
+            .positions()
+            .iter()
+            .zip(&full)
+            .all(|(a, b)| (a - b).norm() <= 1e-12)
+    );
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    harness.run();
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.control(), &after[..], "redo is exact");
+}
+
+#[test]
+fn save_then_open_round_trips_exactly() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    // Change the model first (a drag through the state), so the file is not the fit's.
+    let (k, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    {
+        let state = harness.state_mut().state_mut().unwrap();
+        let vertex = state.mesh().tessellation.vertices[k];
+        state
+            .start_drag(vertex, ntori::editor::state::Grab::Surface, pixel)
+            .unwrap();
+        let target = state.surface_point(vertex) + Point3::new(0.1, -0.05, 0.2);
+        state.drag_to_target(target).unwrap();
+        state.release();
+        assert!(state.is_modified());
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("edited.json");
+    let saved = harness.state().state().unwrap().model();
+    harness.state_mut().save_to(&path).unwrap();
+    assert!(!harness.state().state().unwrap().is_modified());
+    harness.state_mut().open(&path).unwrap();
+    harness.run();
+    let state = harness.state().state().unwrap();
+    let opened = state.model();
+    assert_eq!(opened, saved, "bit for bit");
+    assert_eq!(state.path(), Some(path.as_path()));
+    assert!(!state.is_modified());
+    assert_eq!(ntori::model_file::load(&path).unwrap(), saved);
+}
+
+#[test]
+fn closing_with_unsaved_changes_asks_first() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let (k, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    {
+        let state = harness.state_mut().state_mut().unwrap();
+        let vertex = state.mesh().tessellation.vertices[k];
+        state
+            .start_drag(vertex, ntori::editor::state::Grab::Surface, pixel)
+            .unwrap();
+        state
+            .drag_to_target(state.surface_point(vertex) + Point3::new(0.0, 0.0, 0.1))
+            .unwrap();
+        state.release();
+    }
+    harness
+        .input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    harness.step();
+    let commands = &harness.output().viewport_output[&egui::ViewportId::ROOT].commands;
+    assert!(
+        commands.contains(&egui::ViewportCommand::CancelClose),
+        "the close is held: {commands:?}"
+    );
+    harness.run();
+    assert!(harness.query_by_label("Unsaved changes").is_some());
+    assert!(harness.query_by_label("Don't save").is_some());
+}
+
+#[test]
+fn shortcuts_switch_styles_and_frame_the_view() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    use ntori::render::{CurvatureKind, Style};
+    for (key, style) in [
+        (Key::Num2, Style::Wireframe),
+        (Key::Num3, Style::Charts),
+        (Key::Num4, Style::Curvature(CurvatureKind::Gaussian)),
+        (Key::Num1, Style::Shaded),
+    ] {
+        harness.key_press(key);
+        harness.run();
+        assert_eq!(harness.state().state().unwrap().style(), style);
+    }
+    let camera = harness.state().state().unwrap().camera;
+    harness
+        .state_mut()
+        .state_mut()
+        .unwrap()
+        .camera
+        .orbit([100.0, 30.0], 600.0);
+    harness.key_press(Key::Home);
+    harness.run();
+    assert_eq!(
+        harness.state().state().unwrap().camera.azimuth,
+        camera.azimuth
+    );
+    harness.key_press(Key::F1);
+    harness.run();
+    assert!(
+        harness
+            .query_by_label_contains("smooth closed surface")
+            .is_some()
+    );
+}
+
+#[test]
+fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
+    let dir = tempfile::tempdir().unwrap();
+    // What a crashed editor (a process that no longer exists) left behind.
+    let orphan = RecoveryFile {
+        format: RECOVERY_FORMAT.into(),
+        pid: u32::MAX - 7,
+        saved_at: 0,
+        original: Some(PathBuf::from("/somewhere/sculpture.json")),
+        model: model().clone(),
+    };
+    std::fs::write(
+        dir.path().join("recovery-4294967288.json"),
+        serde_json::to_string(&orphan).unwrap(),
+    )
+    .unwrap();
+    let _gpu = gpu_lock();
+    let mut harness = harness_with(EditorOptions {
+        model: Some(model().clone()),
+        file: None,
+        recovery_dir: Some(dir.path().to_owned()),
+        tessellation: (16, 16),
+    });
+    harness.run();
+    assert_eq!(harness.state().orphans().len(), 1);
+    assert!(harness.query_by_label("Recover unsaved work?").is_some());
+    harness.get_by_label("Recover").click();
+    harness.run();
+    let app = harness.state();
+    let state = app.state().unwrap();
+    assert!(state.is_modified(), "recovered work is unsaved");
+    assert_eq!(
+        state.path(),
+        Some(std::path::Path::new("/somewhere/sculpture.json"))
+    );
+    assert_eq!(state.model(), orphan.model);
+    // The orphan is gone; this editor's own autosave holds the work now.
+    let own = app.recovery().unwrap().own_file().to_owned();
+    assert!(own.exists());
+    assert!(!dir.path().join("recovery-4294967288.json").exists());
+    let mine = Recovery::new(dir.path());
+    assert!(
+        mine.orphans().is_empty(),
+        "a live process's file is not an orphan"
+    );
+}
