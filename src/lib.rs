@@ -13,6 +13,7 @@ pub mod info;
 pub mod mesh;
 pub mod model_file;
 pub mod new;
+pub mod palette;
 pub mod render;
 pub mod spatial;
 pub mod tessellate;

@@ -163,9 +163,9 @@ impl TessellationReport {
     }
 }
 
-/// The fill colour of a triangle: its home chart's tint (see [`crate::figures::palette`]).
+/// The fill colour of a triangle: its home chart's tint (see [`crate::palette`]).
 pub fn fill(kind: ChartKind, region: Region) -> String {
-    use crate::figures::palette;
+    use crate::palette;
     match (region, kind) {
         (Region::InsideWheel, ChartKind::Cap { .. }) => palette::fill(kind),
         (Region::InsideWheel, _) => palette::fill(ChartKind::Inside),

@@ -12,7 +12,17 @@ fn render_writes_a_png_and_refuses_nonsense() {
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("m.json");
     ntori()
-        .args(["new", "--genus", "1", "--resolution", "12", "--grid", "8", "-q", "-o"])
+        .args([
+            "new",
+            "--genus",
+            "1",
+            "--resolution",
+            "12",
+            "--grid",
+            "8",
+            "-q",
+            "-o",
+        ])
         .arg(&model)
         .assert()
         .success();
@@ -20,7 +30,15 @@ fn render_writes_a_png_and_refuses_nonsense() {
     ntori()
         .arg("render")
         .arg(&model)
-        .args(["--size", "200x150", "--style", "curvature", "--tessellation", "8", "-o"])
+        .args([
+            "--size",
+            "200x150",
+            "--style",
+            "curvature",
+            "--tessellation",
+            "8",
+            "-o",
+        ])
         .arg(&png)
         .assert()
         .success()

@@ -47,7 +47,9 @@ fn luminance(p: [u8; 3]) -> f64 {
 fn the_default_view_shows_a_shaded_surface_and_is_stable() {
     let model = model();
     let mut gpu = offscreen();
-    let image = gpu.render_model(&model, &options(Style::Shaded), &[]).unwrap();
+    let image = gpu
+        .render_model(&model, &options(Style::Shaded), &[])
+        .unwrap();
     assert_eq!((image.width, image.height), (320, 240));
     assert_eq!(image.rgba.len(), 320 * 240 * 4);
     let surface = surface_pixels(&image);
@@ -61,8 +63,12 @@ fn the_default_view_shows_a_shaded_surface_and_is_stable() {
     let sd = (lum.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lum.len() as f64).sqrt();
     assert!(sd > 10.0, "shading hardly varies (sd {sd:.1})");
     // Same input, same bytes; a different view, different bytes.
-    let a = gpu.render_model_png(&model, &options(Style::Shaded), &[]).unwrap();
-    let b = gpu.render_model_png(&model, &options(Style::Shaded), &[]).unwrap();
+    let a = gpu
+        .render_model_png(&model, &options(Style::Shaded), &[])
+        .unwrap();
+    let b = gpu
+        .render_model_png(&model, &options(Style::Shaded), &[])
+        .unwrap();
     assert_eq!(a, b);
     let mut turned = options(Style::Shaded);
     turned.view.azimuth_deg += 90.0;
@@ -74,13 +80,29 @@ fn the_default_view_shows_a_shaded_surface_and_is_stable() {
 fn styles_colour_the_surface_as_they_say() {
     let model = model();
     let mut gpu = offscreen();
-    let shaded = gpu.render_model(&model, &options(Style::Shaded), &[]).unwrap();
-    let wire = gpu.render_model(&model, &options(Style::Wireframe), &[]).unwrap();
+    let shaded = gpu
+        .render_model(&model, &options(Style::Shaded), &[])
+        .unwrap();
+    let wire = gpu
+        .render_model(&model, &options(Style::Wireframe), &[])
+        .unwrap();
     // Wireframe darkens the edges: more dark pixels than plain shading.
-    let dark = |im: &Image| surface_pixels(im).iter().filter(|&&p| luminance(p) < 60.0).count();
-    assert!(dark(&wire) > dark(&shaded) + 500, "{} vs {}", dark(&wire), dark(&shaded));
+    let dark = |im: &Image| {
+        surface_pixels(im)
+            .iter()
+            .filter(|&&p| luminance(p) < 60.0)
+            .count()
+    };
+    assert!(
+        dark(&wire) > dark(&shaded) + 500,
+        "{} vs {}",
+        dark(&wire),
+        dark(&shaded)
+    );
     // Charts: several clearly different hues.
-    let charts = gpu.render_model(&model, &options(Style::Charts), &[]).unwrap();
+    let charts = gpu
+        .render_model(&model, &options(Style::Charts), &[])
+        .unwrap();
     let mut hues: Vec<u8> = surface_pixels(&charts)
         .iter()
         .filter(|p| p.iter().max().unwrap() - p.iter().min().unwrap() > 60)
@@ -95,11 +117,21 @@ fn styles_colour_the_surface_as_they_say() {
     assert!(hues.len() >= 3, "chart colours: {hues:?}");
     // Curvature: the holes' saddles are blue, the outer rim red, and a legend is drawn.
     let k = gpu
-        .render_model(&model, &options(Style::Curvature(CurvatureKind::Gaussian)), &[])
+        .render_model(
+            &model,
+            &options(Style::Curvature(CurvatureKind::Gaussian)),
+            &[],
+        )
         .unwrap();
     let px = surface_pixels(&k);
-    let blue = px.iter().filter(|p| i32::from(p[2]) > i32::from(p[0]) + 60).count();
-    let red = px.iter().filter(|p| i32::from(p[0]) > i32::from(p[2]) + 40).count();
+    let blue = px
+        .iter()
+        .filter(|p| i32::from(p[2]) > i32::from(p[0]) + 60)
+        .count();
+    let red = px
+        .iter()
+        .filter(|p| i32::from(p[0]) > i32::from(p[2]) + 40)
+        .count();
     assert!(blue > 100 && red > 100, "blue {blue}, red {red}");
 }
 
@@ -107,7 +139,9 @@ fn styles_colour_the_surface_as_they_say() {
 fn curves_are_drawn_on_top() {
     let model = model();
     let mut gpu = offscreen();
-    let plain = gpu.render_model(&model, &options(Style::Shaded), &[]).unwrap();
+    let plain = gpu
+        .render_model(&model, &options(Style::Shaded), &[])
+        .unwrap();
     let ring: Vec<[f64; 3]> = (0..=64)
         .map(|i| {
             let a = std::f64::consts::TAU * f64::from(i) / 64.0;
@@ -118,8 +152,15 @@ fn curves_are_drawn_on_top() {
         points: ring,
         colour: [1.0, 0.0, 0.0],
     };
-    let with = gpu.render_model(&model, &options(Style::Shaded), &[curve]).unwrap();
-    let red = |im: &Image| im.rgba.chunks(4).filter(|p| p[0] > 200 && p[1] < 40).count();
+    let with = gpu
+        .render_model(&model, &options(Style::Shaded), &[curve])
+        .unwrap();
+    let red = |im: &Image| {
+        im.rgba
+            .chunks(4)
+            .filter(|p| p[0] > 200 && p[1] < 40)
+            .count()
+    };
     assert_eq!(red(&plain), 0);
     assert!(red(&with) > 200, "{} red pixels", red(&with));
 }
@@ -140,15 +181,36 @@ fn impossible_requests_are_errors() {
         ));
     }
     for view in [
-        View { elevation_deg: 95.0, ..View::default() },
-        View { distance: 0.5, ..View::default() },
-        View { azimuth_deg: f64::NAN, ..View::default() },
+        View {
+            elevation_deg: 95.0,
+            ..View::default()
+        },
+        View {
+            distance: 0.5,
+            ..View::default()
+        },
+        View {
+            azimuth_deg: f64::NAN,
+            ..View::default()
+        },
     ] {
-        let o = RenderOptions { view, ..options(Style::Shaded) };
-        assert!(matches!(gpu.render_model(&model, &o, &[]), Err(RenderError::View(_))));
+        let o = RenderOptions {
+            view,
+            ..options(Style::Shaded)
+        };
+        assert!(matches!(
+            gpu.render_model(&model, &o, &[]),
+            Err(RenderError::View(_))
+        ));
     }
     let mut broken = model.clone();
     broken.control_points.pop();
-    assert!(gpu.render_model(&broken, &options(Style::Shaded), &[]).is_err());
-    assert!(gpu.render_mesh_png(&[[0.0; 3]], &[[0, 1, 2]], &options(Style::Shaded)).is_err());
+    assert!(
+        gpu.render_model(&broken, &options(Style::Shaded), &[])
+            .is_err()
+    );
+    assert!(
+        gpu.render_mesh_png(&[[0.0; 3]], &[[0, 1, 2]], &options(Style::Shaded))
+            .is_err()
+    );
 }

@@ -18,7 +18,7 @@ use crate::files::{FileError, write_atomically};
 
 mod charts_figs;
 mod geometry;
-pub mod palette;
+pub use crate::palette;
 mod polygons;
 pub mod renderings;
 mod svg;

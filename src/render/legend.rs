@@ -45,8 +45,7 @@ pub fn draw(image: &mut Image, kind: CurvatureKind, range: f64) {
 }
 
 fn font() -> FontRef<'static> {
-    FontRef::try_from_slice(epaint_default_fonts::UBUNTU_LIGHT)
-        .expect("egui's bundled font parses")
+    FontRef::try_from_slice(epaint_default_fonts::UBUNTU_LIGHT).expect("egui's bundled font parses")
 }
 
 fn text_width(s: &str, size: f32) -> i64 {

@@ -65,8 +65,7 @@ impl View {
         let finite = [self.azimuth_deg, self.elevation_deg, self.distance]
             .iter()
             .all(|v| v.is_finite());
-        if !finite || self.elevation_deg.abs() > 90.0 || !(1.05..=1000.0).contains(&self.distance)
-        {
+        if !finite || self.elevation_deg.abs() > 90.0 || !(1.05..=1000.0).contains(&self.distance) {
             return Err(RenderError::View(format!(
                 "the view azimuth {}, elevation {}, distance {} is not possible: elevation must lie in −90 to 90 degrees and the distance in 1.05 to 1000 bounding radii",
                 self.azimuth_deg, self.elevation_deg, self.distance
@@ -140,7 +139,9 @@ impl Image {
         writer
             .write_image_data(&self.rgba)
             .map_err(|e| RenderError::Png(e.to_string()))?;
-        writer.finish().map_err(|e| RenderError::Png(e.to_string()))?;
+        writer
+            .finish()
+            .map_err(|e| RenderError::Png(e.to_string()))?;
         Ok(out)
     }
 }
@@ -151,6 +152,20 @@ const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const SAMPLES: u32 = 4;
 /// The largest picture side accepted.
 pub const MAX_SIDE: u32 = 8192;
+
+fn request_adapter(backends: wgpu::Backends) -> Result<wgpu::Adapter, RenderError> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+        backends,
+        ..wgpu::InstanceDescriptor::new_without_display_handle()
+    });
+    pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: None,
+        ..Default::default()
+    }))
+    .map_err(|e| RenderError::NoAdapter(e.to_string()))
+}
 
 /// A GPU device for pictures without a window, reused from one picture to the next.
 pub struct Offscreen {
@@ -163,26 +178,20 @@ pub struct Offscreen {
 impl Offscreen {
     /// Opens the first adapter wgpu finds (a GPU, or Mesa's lavapipe on a machine without one).
     pub fn new() -> Result<Offscreen, RenderError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            ..Default::default()
-        }))
-        .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        // Vulkan (or Metal, DX12) first: probing OpenGL through EGL without a display only prints
+        // errors. OpenGL is the fallback where nothing else exists.
+        let adapter = request_adapter(wgpu::Backends::PRIMARY)
+            .or_else(|_| request_adapter(wgpu::Backends::all()))?;
         let adapter_name = adapter.get_info().name;
-        let (device, queue) =
-            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-                label: Some("ntori offscreen"),
-                required_features: wgpu::Features::empty(),
-                required_limits: wgpu::Limits::downlevel_defaults()
-                    .using_resolution(adapter.limits()),
-                experimental_features: Default::default(),
-                memory_hints: wgpu::MemoryHints::MemoryUsage,
-                trace: Default::default(),
-            }))
-            .map_err(|e| RenderError::Device(e.to_string()))?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("ntori offscreen"),
+            required_features: wgpu::Features::empty(),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            experimental_features: Default::default(),
+            memory_hints: wgpu::MemoryHints::MemoryUsage,
+            trace: Default::default(),
+        }))
+        .map_err(|e| RenderError::Device(e.to_string()))?;
         let renderer = SurfaceRenderer::new(&device, OFFSCREEN_FORMAT, SAMPLES);
         tracing::info!(adapter = %adapter_name, "offscreen renderer ready");
         Ok(Offscreen {
@@ -216,8 +225,7 @@ impl Offscreen {
         curves: &[Curve],
     ) -> Result<Image, RenderError> {
         self.check(options)?;
-        let geometry =
-            scene::model_geometry(model, options.tessellation, options.style, curves)?;
+        let geometry = scene::model_geometry(model, options.tessellation, options.style, curves)?;
         self.draw(&geometry, options)
     }
 
@@ -245,7 +253,11 @@ impl Offscreen {
         options.view.validate()
     }
 
-    fn draw(&self, geometry: &SceneGeometry, options: &RenderOptions) -> Result<Image, RenderError> {
+    fn draw(
+        &self,
+        geometry: &SceneGeometry,
+        options: &RenderOptions,
+    ) -> Result<Image, RenderError> {
         let (width, height) = (options.width, options.height);
         let camera = Camera {
             centre: geometry.centre,
@@ -254,24 +266,29 @@ impl Offscreen {
             aspect: width as f32 / height as f32,
         };
         let scene = GpuScene::new(&self.device, &geometry.vertices, &geometry.segments);
-        self.renderer
-            .set_frame(&self.queue, &camera.uniforms(options.style, (width, height)));
+        let mut frame = camera.uniforms(options.style, (width, height));
+        if geometry.legend.is_some() {
+            // Leave room at the right for the legend.
+            let shift = glam::Mat4::from_translation(glam::Vec3::new(-0.14, 0.0, 0.0));
+            frame.view_proj =
+                (shift * glam::Mat4::from_cols_array_2d(&frame.view_proj)).to_cols_array_2d();
+        }
+        self.renderer.set_frame(&self.queue, &frame);
         let target = |label, format, samples, usage| {
-            self.device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width,
-                        height,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
+            self.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
         };
         let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let msaa = target("ntori msaa", OFFSCREEN_FORMAT, SAMPLES, attachment);
@@ -327,7 +344,8 @@ impl Offscreen {
         height: u32,
     ) -> Result<Image, RenderError> {
         let row = 4 * width;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ntori readback"),
             size: u64::from(padded) * u64::from(height),

@@ -6,7 +6,7 @@ use embedding::{Layout, Model, Point3, Stencil};
 use glam::{Mat4, Vec3};
 
 use super::gpu::{FrameUniforms, Segment, SurfaceVertex};
-use super::{Curve, CurvatureKind, RenderError, Style, View};
+use super::{CurvatureKind, Curve, RenderError, Style, View};
 
 /// Where the camera looks from: the bounding sphere of what is drawn and a [`View`] around it.
 #[derive(Clone, Copy, Debug)]
@@ -64,7 +64,13 @@ impl Camera {
             eye: self.eye().extend(1.0).to_array(),
             light: self.light().extend(0.0).to_array(),
             params: [f32::from(u8::from(wire)), 1.2, 0.22, 0.25],
-            viewport: [size.0 as f32, size.1 as f32, 3.0, 2e-4],
+            // Curves stay readable when printed: about 1/180 of the picture's height, at least 3 px.
+            viewport: [
+                size.0 as f32,
+                size.1 as f32,
+                (size.1 as f32 / 180.0).max(3.0),
+                2e-4,
+            ],
         }
     }
 }
@@ -82,7 +88,8 @@ pub struct SceneGeometry {
 /// The shaded style's colour.
 pub const SURFACE_COLOUR: [f32; 3] = [0.55, 0.68, 0.9];
 
-/// One colour per chart: the inside chart, the vertex chart, then the edge charts in turn.
+/// A fixed palette indexed by chart id. The renderer's charts style uses [`crate::palette`] (one
+/// colour per chart kind and edge pair, as in the figures); this stays for callers that only know ids.
 pub const CHART_PALETTE: [[f32; 3]; 8] = [
     [0.89, 0.35, 0.32],
     [0.35, 0.72, 0.38],
@@ -116,7 +123,7 @@ pub fn model_geometry(
         Style::Charts => (
             tess.vertices
                 .iter()
-                .map(|p| blend_colour(&layout.blends(*p)))
+                .map(|p| blend_colour(&atlas, &layout.blends(*p)))
                 .collect(),
             None,
         ),
@@ -168,7 +175,11 @@ pub fn mesh_geometry(
         let [a, b, c] = t.map(|v| Vec3::from(positions[v as usize].map(|x| x as f32)));
         let n = (b - a).cross(c - a).normalize_or_zero();
         for &v in t {
-            corners.push((positions[v as usize], n.as_dvec3().to_array(), SURFACE_COLOUR));
+            corners.push((
+                positions[v as usize],
+                n.as_dvec3().to_array(),
+                SURFACE_COLOUR,
+            ));
         }
         flat.push([3 * k as u32, 3 * k as u32 + 1, 3 * k as u32 + 2]);
     }
@@ -189,7 +200,8 @@ fn unindexed(corners: &[([f64; 3], [f64; 3], [f32; 3])], triangles: &[[u32; 3]])
             });
         }
     }
-    let (centre, radius) = bounding_sphere(corners.iter().map(|c| Vec3::from(c.0.map(|x| x as f32))));
+    let (centre, radius) =
+        bounding_sphere(corners.iter().map(|c| Vec3::from(c.0.map(|x| x as f32))));
     SceneGeometry {
         vertices,
         segments: Vec::new(),
@@ -201,11 +213,10 @@ fn unindexed(corners: &[([f64; 3], [f64; 3], [f32; 3])], triangles: &[[u32; 3]])
 
 /// The centre of the bounding box and the largest distance from it.
 fn bounding_sphere(points: impl Iterator<Item = Vec3> + Clone) -> (Vec3, f32) {
-    let (lo, hi) = points
-        .clone()
-        .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
-            (lo.min(p), hi.max(p))
-        });
+    let (lo, hi) = points.clone().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
     let centre = (lo + hi) / 2.0;
     let radius = points.map(|p| (p - centre).length()).fold(0.0, f32::max);
     (centre, radius.max(1e-6))
@@ -224,10 +235,11 @@ fn segments(curves: &[Curve]) -> Vec<Segment> {
         .collect()
 }
 
-fn blend_colour(blends: &[(charts::ChartId, f64)]) -> [f32; 3] {
+/// Σ b̂_c · colour of chart c, in the figures' palette (one colour per chart kind and edge pair).
+fn blend_colour(atlas: &Atlas, blends: &[(charts::ChartId, f64)]) -> [f32; 3] {
     let mut c = [0.0f32; 3];
     for &(chart, b) in blends {
-        let k = CHART_PALETTE[chart.index() % CHART_PALETTE.len()];
+        let k = crate::palette::surface_rgb(atlas.charts()[chart.index()].kind());
         for ch in 0..3 {
             c[ch] += b as f32 * k[ch];
         }
@@ -238,7 +250,11 @@ fn blend_colour(blends: &[(charts::ChartId, f64)]) -> [f32; 3] {
 /// The 95th percentile of |v|: the colour scale's end, so that a few extreme values do not wash
 /// the rest out. Never zero.
 pub fn robust_range(values: &[f64]) -> f64 {
-    let mut abs: Vec<f64> = values.iter().map(|v| v.abs()).filter(|v| v.is_finite()).collect();
+    let mut abs: Vec<f64> = values
+        .iter()
+        .map(|v| v.abs())
+        .filter(|v| v.is_finite())
+        .collect();
     if abs.is_empty() {
         return 1.0;
     }

@@ -1,5 +1,6 @@
-//! One colour per chart kind and per edge pair, used by every figure (and by `ntori tessellate
-//! --svg`): a light tint to fill regions with and a dark shade of the same hue for lines and labels.
+//! One colour per chart kind and per edge pair, used by every figure, by `ntori tessellate --svg` and
+//! by the renderer's charts style: a light tint to fill regions with, a dark shade of the same hue for
+//! lines and labels, and a middle tone for lit 3D surfaces.
 //!
 //! Edge chart j = 2k + t (the pair a_k/a_k⁻¹ for t = 0, b_k/b_k⁻¹ for t = 1) gets the hue
 //! 200° + 137.5°·j (the golden angle, so neighbouring pairs differ clearly); the inside chart is
@@ -51,6 +52,16 @@ pub fn stroke_rgb(kind: ChartKind) -> [f32; 3] {
         ChartKind::Cap { north: false } => hex(0x2f6ea8),
         ChartKind::Vertex => hex(0x555555),
         ChartKind::Edge { handle, side } => hsl(edge_hue(2 * handle + side), 0.65, 0.36),
+    }
+}
+
+/// A middle tone of the same hue, for lit 3D surfaces (the tints wash out under lighting).
+pub fn surface_rgb(kind: ChartKind) -> [f32; 3] {
+    match kind {
+        ChartKind::Inside | ChartKind::Cap { north: true } => hex(0xe8964a),
+        ChartKind::Cap { north: false } => hex(0x5a8fc4),
+        ChartKind::Vertex => hex(0x9a9a9a),
+        ChartKind::Edge { handle, side } => hsl(edge_hue(2 * handle + side), 0.55, 0.55),
     }
 }
 
