@@ -197,6 +197,12 @@ enum Command {
         #[arg(long, default_value_t = ntori::editor::state::DEFAULT_T, value_name = "B",
               value_parser = clap::value_parser!(u32).range(1..=i64::from(ntori::editor::state::MAX_T)))]
         tr: u32,
+        /// For smoke tests: close after this many frames.
+        #[arg(long, hide = true, value_name = "N")]
+        exit_after_frames: Option<u32>,
+        /// For smoke tests: write the viewport's picture here before closing.
+        #[arg(long, hide = true, value_name = "PNG")]
+        screenshot_on_exit: Option<std::path::PathBuf>,
     },
     /// Export a model's surface as a triangle mesh: OBJ, PLY, STL, GLB or OFF.
     ///
@@ -356,18 +362,6 @@ fn main() -> ExitCode {
     }
 }
 
-fn edit(model: Option<std::path::PathBuf>, te: u32, tr: u32) -> anyhow::Result<ExitCode> {
-    let loaded = model.as_deref().map(ntori::model_file::load).transpose()?;
-    let options = ntori::editor::EditorOptions {
-        model: loaded,
-        file: model,
-        tessellation: (te, tr),
-        ..Default::default()
-    };
-    ntori::editor::run(options).map_err(|e| anyhow::anyhow!("the editor failed: {e}"))?;
-    Ok(ExitCode::SUCCESS)
-}
-
 /// Writes to stdout; a closed pipe (`ntori info | head`) is not an error.
 fn write_stdout(text: &str) -> anyhow::Result<()> {
     use std::io::Write as _;
@@ -467,7 +461,25 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(3)
             })
         }
-        Command::Edit { model, te, tr } => edit(model, te, tr),
+        Command::Edit {
+            model,
+            te,
+            tr,
+            exit_after_frames,
+            screenshot_on_exit,
+        } => {
+            let loaded = model.as_deref().map(ntori::model_file::load).transpose()?;
+            let options = ntori::editor::EditorOptions {
+                model: loaded,
+                file: model,
+                tessellation: (te, tr),
+                exit_after_frames,
+                screenshot_on_exit,
+                ..Default::default()
+            };
+            ntori::editor::run(options).map_err(|e| anyhow::anyhow!("the editor failed: {e}"))?;
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Export {
             model,
             output,

@@ -48,6 +48,7 @@ fn harness() -> Harness<'static, EditorApp> {
         file: None,
         recovery_dir: None,
         tessellation: (24, 24),
+        ..EditorOptions::default()
     })
 }
 
@@ -182,16 +183,17 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
     let _gpu = gpu_lock();
     let mut harness = harness();
 
-    // Two pins by Ctrl + click, away from the drag.
+    // Pins by Ctrl + click: two far from the drag, one near it (sharing control points with the
+    // dragged point, so the solve must hold it).
     let mut pins = Vec::new();
-    for at in [[0.3, 0.45], [0.72, 0.55]] {
+    for at in [[0.3, 0.45], [0.72, 0.55], [0.55, 0.53]] {
         let (_, pixel) = visible_vertex(harness.state_mut(), at);
         let pos = pos_of(harness.state(), pixel);
         command_click(&mut harness, pos);
         pins.push(pixel);
     }
     let state = harness.state().state().unwrap();
-    assert_eq!(state.pins().len(), 2, "Ctrl + click pins");
+    assert_eq!(state.pins().len(), 3, "Ctrl + click pins");
     let pinned: Vec<(ChartPoint, Point3)> = state
         .pins()
         .iter()
@@ -212,6 +214,23 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
         harness.step();
     }
     let end = start + shift;
+    // Mid-drag, the GPU moves the reached vertices from the displacement alone; the CPU reference
+    // does the same arithmetic.
+    let mid_picture = harness
+        .state()
+        .screenshot()
+        .expect("the viewport was drawn");
+    let (reference, rows) = {
+        let state = harness.state().state().unwrap();
+        let plan = &state.drag().expect("dragging").plan;
+        assert!(
+            !plan.pins.is_empty(),
+            "the near pin takes part in the solve"
+        );
+        let mut vertices = state.mesh().vertices().to_vec();
+        plan.move_vertices(plan.displacement, &mut vertices);
+        (vertices, plan.rows.clone())
+    };
     harness.drop_at(end);
     harness.step();
     harness.run();
@@ -269,6 +288,37 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
     let after = state.control().to_vec();
     assert_ne!(before, after);
     assert!(state.is_modified());
+    // The drag's vertex update (p0 + gΔ, tangents likewise) agrees with the exact rows.
+    for &r in &rows {
+        let v = reference[r as usize];
+        let exact = mesh.positions()[r as usize];
+        let p = Point3::new(
+            v.position[0].into(),
+            v.position[1].into(),
+            v.position[2].into(),
+        );
+        assert!((p - exact).norm() < 1e-5 * model_size, "vertex {r}");
+        let n = Point3::new(v.normal[0].into(), v.normal[1].into(), v.normal[2].into());
+        let [u, w] = mesh.tangents()[r as usize];
+        assert!((n - u.cross(&w).normalize()).norm() < 1e-4, "normal {r}");
+    }
+    // And the picture drawn mid-drag matches the one drawn from the exact surface afterwards.
+    let exact_picture = harness.state().screenshot().unwrap();
+    assert_eq!(
+        (mid_picture.width, mid_picture.height),
+        (exact_picture.width, exact_picture.height)
+    );
+    let differing = mid_picture
+        .rgba
+        .chunks(4)
+        .zip(exact_picture.rgba.chunks(4))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count();
+    println!("{differing} pixels differ between the drag's picture and the exact one");
+    assert!(differing * 1000 < mid_picture.rgba.len() / 4);
+    let mid_path = artefact_dir().join("mid-drag-viewport.png");
+    std::fs::write(&mid_path, mid_picture.to_png().unwrap()).unwrap();
+    println!("the viewport mid-drag: {}", mid_path.display());
 
     // A screenshot of the whole window after the drag, kept as an artefact.
     let image = harness.render().expect("the window renders");
@@ -282,6 +332,18 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
     let state = harness.state().state().unwrap();
     assert_eq!(state.control(), &before[..], "undo is exact");
     assert!(!state.is_modified(), "back at the saved state");
+    let undone_picture = harness.state().screenshot().unwrap();
+    let changed = mid_picture
+        .rgba
+        .chunks(4)
+        .zip(undone_picture.rgba.chunks(4))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count();
+    assert!(
+        changed * 100 > mid_picture.rgba.len() / 4,
+        "the drag showed on screen ({changed} pixels differ from the undone surface)"
+    );
+    let state = harness.state().state().unwrap();
     let mut full = vec![Point3::zeros(); state.mesh().vertex_count()];
     state.mesh().stencil().positions(state.control(), &mut full);
     assert!(
@@ -423,6 +485,7 @@ fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
         file: None,
         recovery_dir: Some(dir.path().to_owned()),
         tessellation: (16, 16),
+        ..EditorOptions::default()
     });
     harness.run();
     assert_eq!(harness.state().orphans().len(), 1);
@@ -446,4 +509,59 @@ fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
         mine.orphans().is_empty(),
         "a live process's file is not an orphan"
     );
+}
+
+/// The real window: `ntori edit` under Xvfb (winit, a wgpu surface on lavapipe), closing itself
+/// after some frames with a picture of its viewport. Skipped where xvfb-run is missing.
+#[test]
+fn ntori_edit_runs_under_xvfb() {
+    let has_xvfb = std::env::var_os("PATH")
+        .is_some_and(|paths| std::env::split_paths(&paths).any(|d| d.join("xvfb-run").is_file()));
+    if !has_xvfb {
+        eprintln!("skipped: xvfb-run is not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let model_path = dir.path().join("model.json");
+    ntori::model_file::save(&model_path, model()).unwrap();
+    let picture = artefact_dir().join("xvfb-window-viewport.png");
+    let _ = std::fs::remove_file(&picture);
+    let runtime = dir.path().join("runtime");
+    std::fs::create_dir(&runtime).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        std::fs::set_permissions(&runtime, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    let output = std::process::Command::new("timeout")
+        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 1280x800x24"])
+        .arg(env!("CARGO_BIN_EXE_ntori"))
+        .arg("edit")
+        .arg(&model_path)
+        .args(["--exit-after-frames", "10", "--screenshot-on-exit"])
+        .arg(&picture)
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .env("XDG_STATE_HOME", dir.path().join("state"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "ntori edit failed: {stderr}");
+    assert!(stderr.contains("10 frames"), "{stderr}");
+    let png = std::fs::read(&picture).expect("the viewport's picture");
+    let decoder = png::Decoder::new(std::io::Cursor::new(png));
+    let mut reader = decoder.read_info().unwrap();
+    let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut pixels).unwrap();
+    // The surface's blue covers a good part of the viewport.
+    let blue = pixels[..info.buffer_size()]
+        .chunks(4)
+        .filter(|p| p[2] > 150 && p[2] > p[0] + 40)
+        .count();
+    assert!(
+        blue * 10 > info.width as usize * info.height as usize,
+        "{blue} surface pixels of {}×{}",
+        info.width,
+        info.height
+    );
+    println!("the window's viewport under Xvfb: {}", picture.display());
 }

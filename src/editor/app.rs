@@ -16,7 +16,6 @@ use embedding::{Model, Point3, SplineSettings};
 use super::gpu::ViewportRenderer;
 use super::recovery::{Orphan, Recovery};
 use super::state::{DEFAULT_T, EditorError, EditorState, Grab, MAX_T, Pick, refit};
-use crate::render::scene::CHART_PALETTE;
 use crate::render::{CurvatureKind, Style};
 
 /// How the editor starts.
@@ -30,6 +29,10 @@ pub struct EditorOptions {
     pub recovery_dir: Option<PathBuf>,
     /// The tessellation (t_e, t_r).
     pub tessellation: (u32, u32),
+    /// For smoke tests of the real window: close after this many frames with a model shown,
+    /// writing the viewport's picture to `screenshot_on_exit` first (if set).
+    pub exit_after_frames: Option<u32>,
+    pub screenshot_on_exit: Option<PathBuf>,
 }
 
 impl Default for EditorOptions {
@@ -39,6 +42,8 @@ impl Default for EditorOptions {
             file: None,
             recovery_dir: Recovery::default_dir(),
             tessellation: (DEFAULT_T, DEFAULT_T),
+            exit_after_frames: None,
+            screenshot_on_exit: None,
         }
     }
 }
@@ -149,6 +154,7 @@ fn push_capped(v: &mut Vec<f64>, x: f64) {
 /// The editor application.
 pub struct EditorApp {
     state: Option<EditorState>,
+    render_state: Option<egui_wgpu::RenderState>,
     gpu: Option<ViewportRenderer>,
     texture: Option<(egui::TextureId, u64)>,
     job: Option<Job>,
@@ -174,14 +180,22 @@ pub struct EditorApp {
     /// The tessellation used when the first model arrives.
     tessellation: (u32, u32),
     native_dialogs: bool,
+    /// Frames drawn with a model (for `exit_after_frames`).
+    frames: u32,
+    exit_after_frames: Option<u32>,
+    screenshot_on_exit: Option<PathBuf>,
+    title: String,
+    /// What the viewport last drew (uniforms, size, texture), to skip drawing an unchanged view.
+    last_drawn: Option<(Vec<u8>, [u32; 2])>,
 }
 
 impl EditorApp {
-    pub fn new(_cc: &eframe::CreationContext<'_>, options: EditorOptions) -> EditorApp {
+    pub fn new(cc: &eframe::CreationContext<'_>, options: EditorOptions) -> EditorApp {
         let recovery = options.recovery_dir.map(Recovery::new);
         let orphans = recovery.as_ref().map(Recovery::orphans).unwrap_or_default();
         let mut app = EditorApp {
             state: None,
+            render_state: cc.wgpu_render_state.clone(),
             gpu: None,
             texture: None,
             job: None,
@@ -204,6 +218,11 @@ impl EditorApp {
             draft_t: options.tessellation,
             tessellation: options.tessellation,
             native_dialogs: native_dialogs_available(),
+            frames: 0,
+            exit_after_frames: options.exit_after_frames,
+            screenshot_on_exit: options.screenshot_on_exit,
+            title: String::new(),
+            last_drawn: None,
         };
         match options.model {
             Some(model) => {
@@ -289,8 +308,8 @@ impl EditorApp {
         Ok(())
     }
     /// The viewport's last picture.
-    pub fn screenshot(&self, frame: &eframe::Frame) -> Result<crate::render::Image, EditorError> {
-        let (Some(gpu), Some(rs)) = (&self.gpu, frame.wgpu_render_state()) else {
+    pub fn screenshot(&self) -> Result<crate::render::Image, EditorError> {
+        let (Some(gpu), Some(rs)) = (&self.gpu, &self.render_state) else {
             return Err(EditorError::Other("no GPU viewport".into()));
         };
         Ok(gpu.read_back(&rs.device, &rs.queue)?)
@@ -665,8 +684,34 @@ impl eframe::App for EditorApp {
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui, frame));
 
         self.dialogs(&ctx);
-        self.take_screenshot(frame);
+        self.take_screenshot();
         self.autosave(false);
+        self.update_title(&ctx);
+        if self.state.is_some() {
+            self.frames += 1;
+            if self.exit_after_frames.is_some_and(|n| self.frames >= n) {
+                self.exit_after_frames = None;
+                if let Some(path) = self.screenshot_on_exit.take() {
+                    self.pending_screenshot = Some(path);
+                    self.take_screenshot();
+                }
+                for (text, _) in self.messages() {
+                    eprintln!("ntori edit: {text}");
+                }
+                let frame = Timings::mean(&self.timings.intervals).unwrap_or(0.0);
+                let cpu = Timings::mean(&self.timings.cpu).unwrap_or(0.0);
+                eprintln!(
+                    "ntori edit: {} frames, {:.1} ms per frame ({:.1} ms on the CPU)",
+                    self.frames,
+                    1e3 * frame,
+                    1e3 * cpu
+                );
+                self.allow_close = true;
+                self.close_now = true;
+            } else if self.exit_after_frames.is_some() {
+                ctx.request_repaint();
+            }
+        }
         if self.close_now {
             self.close_now = false;
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
@@ -798,6 +843,28 @@ impl EditorApp {
                 Some(c) if c.0 + 1 < charts => Some(ChartId(c.0 + 1)),
                 Some(_) => None,
             };
+        }
+    }
+
+    fn update_title(&mut self, ctx: &Context) {
+        let title = match &self.state {
+            Some(state) => format!(
+                "{}{} — ntori",
+                state
+                    .path()
+                    .and_then(Path::file_name)
+                    .map_or("untitled".into(), |n| n.to_string_lossy().into_owned()),
+                if state.is_modified() {
+                    " (modified)"
+                } else {
+                    ""
+                }
+            ),
+            None => "ntori".into(),
+        };
+        if title != self.title {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
+            self.title = title;
         }
     }
 
@@ -1300,9 +1367,15 @@ impl EditorApp {
                 let gpu = self
                     .gpu
                     .get_or_insert_with(|| ViewportRenderer::new(&rs.device));
-                gpu.sync(&rs.device, &rs.queue, state.mesh_mut());
+                let changed =
+                    state.with_display(|mesh, drag| gpu.sync(&rs.device, &rs.queue, mesh, drag));
                 let uniforms = state.camera.uniforms(state.style(), size_px);
-                gpu.render(&rs.device, &rs.queue, size_px, &uniforms);
+                let key = (bytemuck::bytes_of(&uniforms).to_vec(), size_px);
+                if changed || self.last_drawn.as_ref() != Some(&key) || gpu.texture_view().is_none()
+                {
+                    gpu.render(&rs.device, &rs.queue, size_px, &uniforms);
+                    self.last_drawn = Some(key);
+                }
                 let generation = gpu.generation;
                 let Some(view) = gpu.texture_view() else {
                     unreachable!("rendered above")
@@ -1352,7 +1425,11 @@ impl EditorApp {
             let g = state.settings().grid;
             let net = state.control_net(chart);
             let colour = {
-                let c = CHART_PALETTE[chart.index() % CHART_PALETTE.len()];
+                let c = state
+                    .atlas()
+                    .charts()
+                    .get(chart.index())
+                    .map_or([0.8; 3], |k| crate::palette::stroke_rgb(k.kind()));
                 Color32::from_rgb(
                     (c[0] * 255.0) as u8,
                     (c[1] * 255.0) as u8,
@@ -1592,12 +1669,12 @@ impl EditorApp {
         }
     }
 
-    fn take_screenshot(&mut self, frame: &eframe::Frame) {
+    fn take_screenshot(&mut self) {
         let Some(path) = self.pending_screenshot.take() else {
             return;
         };
         let result = self
-            .screenshot(frame)
+            .screenshot()
             .and_then(|image| Ok(image.to_png()?))
             .and_then(|png| Ok(crate::files::write_atomically(&path, &png)?));
         match result {

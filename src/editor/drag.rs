@@ -8,9 +8,15 @@
 //! for a fixed set of control points with fixed β (the constraint rows do not change during a
 //! drag). So at the start the plan also collects, for each vertex those control points reach, its
 //! position and tangents then and the gains g = Σ_c w_c β_c (and the same for the u and v
-//! derivative weights); an event then moves each such vertex to p₀ + g Δ and its tangents likewise,
-//! a few multiply-adds per vertex instead of its whole stencil row. When the drag ends, the moved
-//! rows are recomputed exactly from the stencil.
+//! derivative weights): such a vertex is at p₀ + g Δ, its tangents likewise, a few multiply-adds
+//! instead of its whole stencil row. These [`DragRow`]s go to the GPU once, at the start; each event
+//! then only sends Δ, and the vertex shader moves the vertices (see `pulled.wgsl`).
+//! [`DragPlan::move_vertices`] is the same on the CPU (the reference the tests compare with). When
+//! the drag ends, the moved rows are recomputed exactly from the stencil.
+//!
+//! Pins that cannot interact with the drag — no control point of theirs can move, directly or through
+//! another pin that shares control points with the moving ones — are left out of the system: their
+//! control points do not move at all, so they stay exactly, and the drag reaches fewer vertices.
 //!
 //! The optional influence radius widens the edit: control points within the radius of the picked
 //! point first move by Δ times a smooth falloff (1 at the point, 0 at the radius), then the
@@ -20,7 +26,20 @@ use charts::ChartPoint;
 use embedding::edit::{Constraint, solve};
 use embedding::{EmbeddingError, Layout, Point3};
 
+use bytemuck::{Pod, Zeroable};
+
 use super::mesh::{LiveMesh, ViewVertex};
+
+/// A vertex a drag moves, as the GPU reads it: its position and tangents when the drag began, and
+/// its gains (position = base + g Δ, S_u = u + g_u Δ, S_v = v + g_v Δ). 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DragRow {
+    pub base: [f32; 9],
+    pub gain: [f32; 3],
+}
+
+static NEXT_PLAN: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
 /// A drag in progress.
 #[derive(Clone, Debug)]
@@ -37,11 +56,11 @@ pub struct DragPlan {
     /// Every control point an event may move (sorted), and how: ΔP_c = beta_c Δ.
     pub touched: Vec<u32>,
     beta: Vec<f64>,
-    /// The vertices those control points reach (sorted), their position and tangents when the drag
-    /// began, and their gains.
+    /// The vertices those control points reach (sorted), and how they move.
     pub rows: Vec<u32>,
-    base: Vec<[f32; 9]>,
-    gain: Vec<[f32; 3]>,
+    pub moves: Vec<DragRow>,
+    /// Names this plan (the GPU uploads a plan's rows once).
+    pub id: u64,
     /// The displacement of the last event.
     pub displacement: Point3,
     /// The least-squares residual of the last solve (0 unless constraints conflict).
@@ -60,13 +79,6 @@ impl DragPlan {
         radius: f64,
     ) -> Result<DragPlan, EmbeddingError> {
         let start_position = layout.eval(control, point).pos;
-        let pins: Vec<Constraint> = pins
-            .iter()
-            .map(|&p| Constraint {
-                point: p,
-                target: layout.eval(control, p).pos,
-            })
-            .collect();
         let soft: Vec<(u32, f64)> = if radius > 0.0 {
             control
                 .iter()
@@ -79,6 +91,50 @@ impl DragPlan {
         } else {
             Vec::new()
         };
+        // The pins that interact with the drag: grow the set of control points that may move.
+        let mut moving = vec![false; control.len()];
+        let mut row = Vec::new();
+        layout.weights(point, &mut row);
+        for c in row
+            .iter()
+            .map(|w| w.control)
+            .chain(soft.iter().map(|s| s.0))
+        {
+            moving[c as usize] = true;
+        }
+        let supports: Vec<Vec<u32>> = pins
+            .iter()
+            .map(|&p| {
+                row.clear();
+                layout.weights(p, &mut row);
+                row.iter().map(|w| w.control).collect()
+            })
+            .collect();
+        let mut active = vec![false; pins.len()];
+        loop {
+            let mut grew = false;
+            for (i, support) in supports.iter().enumerate() {
+                if !active[i] && support.iter().any(|&c| moving[c as usize]) {
+                    active[i] = true;
+                    grew = true;
+                    for &c in support {
+                        moving[c as usize] = true;
+                    }
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        let pins: Vec<Constraint> = pins
+            .iter()
+            .zip(&active)
+            .filter(|&(_, &a)| a)
+            .map(|(&p, _)| Constraint {
+                point: p,
+                target: layout.eval(control, p).pos,
+            })
+            .collect();
         let mut plan = DragPlan {
             point,
             start_position,
@@ -88,8 +144,8 @@ impl DragPlan {
             touched: Vec::new(),
             beta: Vec::new(),
             rows: Vec::new(),
-            base: Vec::new(),
-            gain: Vec::new(),
+            moves: Vec::new(),
+            id: NEXT_PLAN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             displacement: Point3::zeros(),
             residual: 0.0,
         };
@@ -99,31 +155,38 @@ impl DragPlan {
         touched.sort_unstable_by_key(|t| t.0);
         plan.touched = touched.iter().map(|t| t.0).collect();
         plan.beta = touched.iter().map(|t| t.1).collect();
-        plan.rows = mesh.rows_of_controls(&plan.touched);
-        // Gains: scatter each touched column into its rows.
-        let mut slot = vec![u32::MAX; mesh.vertex_count()];
-        for (k, &r) in plan.rows.iter().enumerate() {
-            slot[r as usize] = k as u32;
-        }
-        let mut gain = vec![[0.0f64; 3]; plan.rows.len()];
+        // Gains: scatter each touched column into a per-vertex array, then gather the rows reached.
+        let n = mesh.vertex_count();
+        let mut dense = vec![[0.0f64; 3]; n];
+        let mut reached = vec![false; n];
         for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
             for (r, w) in mesh.stencil().column(mesh.columns(), c as usize) {
-                let g = &mut gain[slot[r as usize] as usize];
+                let g = &mut dense[r as usize];
                 for a in 0..3 {
                     g[a] += w[a] * b;
                 }
+                reached[r as usize] = true;
             }
         }
-        plan.gain = gain.iter().map(|g| g.map(|x| x as f32)).collect();
+        plan.rows = (0..n as u32).filter(|&r| reached[r as usize]).collect();
         let (positions, tangents) = (mesh.positions(), mesh.tangents());
-        plan.base = plan
+        plan.moves = plan
             .rows
             .iter()
             .map(|&r| {
                 let (p, [u, v]) = (positions[r as usize], tangents[r as usize]);
-                [p.x, p.y, p.z, u.x, u.y, u.z, v.x, v.y, v.z].map(|x| x as f32)
+                DragRow {
+                    base: [p.x, p.y, p.z, u.x, u.y, u.z, v.x, v.y, v.z].map(|x| x as f32),
+                    gain: dense[r as usize].map(|x| x as f32),
+                }
             })
             .collect();
+        // Tell the GPU copy which vertices follow the drag (flags: the row's index + 1).
+        let vertices = mesh.vertices_mut();
+        for (k, &r) in plan.rows.iter().enumerate() {
+            vertices[r as usize].flags = k as u32 + 1;
+        }
+        mesh.mark_dirty(&plan.rows);
         Ok(plan)
     }
 
@@ -168,15 +231,14 @@ impl DragPlan {
         Ok((merged, edit.residual))
     }
 
-    /// One drag event: the dragged point's new target. Solves, writes the new control points into
-    /// `control` (start + change, for the touched ones), and moves the reached vertices in the GPU
-    /// copy (`vertices`, indexed by vertex). Returns the residual.
+    /// One drag event: the dragged point's new target. Solves and writes the new control points
+    /// into `control` (start + change, for the touched ones); the vertices follow on the GPU from
+    /// [`DragPlan::displacement`]. Returns the residual.
     pub fn drag_to(
         &mut self,
         layout: &Layout,
         target: Point3,
         control: &mut [Point3],
-        vertices: &mut [ViewVertex],
     ) -> Result<f64, EmbeddingError> {
         let delta = target - self.start_position;
         let (moved, residual) = self.solve(layout, delta)?;
@@ -188,17 +250,17 @@ impl DragPlan {
         }
         self.displacement = delta;
         self.residual = residual;
-        self.move_vertices(delta, vertices);
         Ok(residual)
     }
 
-    /// The vertices' new positions and normals for displacement `delta` (sorted rows, so the
-    /// vertex array splits into disjoint pieces, one per thread).
+    /// The vertices' positions and normals for displacement `delta`, written into a vertex array on
+    /// the CPU: what the vertex shader does (sorted rows, so the array splits into disjoint pieces,
+    /// one per thread).
     pub fn move_vertices(&self, delta: Point3, vertices: &mut [ViewVertex]) {
         let d = [delta.x as f32, delta.y as f32, delta.z as f32];
         let work = |first: usize, rows: &[u32], out: &mut [ViewVertex], offset: usize| {
             for (k, &r) in (first..).zip(rows) {
-                let (b, g) = (&self.base[k], &self.gain[k]);
+                let DragRow { base: b, gain: g } = &self.moves[k];
                 let p = [b[0] + g[0] * d[0], b[1] + g[0] * d[1], b[2] + g[0] * d[2]];
                 let u = [b[3] + g[1] * d[0], b[4] + g[1] * d[1], b[5] + g[1] * d[2]];
                 let v = [b[6] + g[2] * d[0], b[7] + g[2] * d[1], b[8] + g[2] * d[2]];

@@ -4,7 +4,10 @@
 //! as a texture, so the 3D view has a depth buffer whatever egui's own pass has, and the same
 //! picture serves for screenshots and the tests.
 
-use super::mesh::{LiveMesh, ViewVertex};
+use embedding::Point3;
+
+use super::drag::DragRow;
+use super::mesh::LiveMesh;
 use crate::render::gpu::{DEPTH_FORMAT, FrameUniforms};
 use crate::render::{Image, RenderError};
 
@@ -40,11 +43,18 @@ pub struct ViewportRenderer {
     frame_group: wgpu::BindGroup,
     mesh_layout: wgpu::BindGroupLayout,
     mesh: Option<MeshBuffers>,
+    /// The drag rows of the last drag plan uploaded (its id), and the displacement uniform.
+    drag_rows: wgpu::Buffer,
+    drag_id: u64,
+    drag_uniform: wgpu::Buffer,
+    drag_delta: [f32; 4],
     targets: Option<Targets>,
     /// Bumped whenever the resolved texture is made anew (egui must be told).
     pub generation: u64,
-    /// Bytes uploaded by the last [`ViewportRenderer::sync`].
+    /// Bytes of vertices uploaded by the last [`ViewportRenderer::sync`], and of drag rows by the
+    /// last drag start.
     pub last_upload: usize,
+    pub last_drag_upload: usize,
 }
 
 impl ViewportRenderer {
@@ -80,8 +90,29 @@ impl ViewportRenderer {
         };
         let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ntori editor mesh"),
-            entries: &[storage(0), storage(1)],
+            entries: &[
+                storage(0),
+                storage(1),
+                storage(2),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::VERTEX,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
         });
+        let drag_uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ntori editor drag"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let drag_rows = drag_buffer(device, &[]);
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("ntori editor frame"),
             layout: &frame_layout,
@@ -149,50 +180,75 @@ impl ViewportRenderer {
             frame_group,
             mesh_layout,
             mesh: None,
+            drag_rows,
+            drag_id: 0,
+            drag_uniform,
+            drag_delta: [0.0; 4],
             targets: None,
             generation: 0,
             last_upload: 0,
+            last_drag_upload: 0,
         }
     }
 
     /// Brings the GPU's copy of the mesh up to date: new buffers after a new tessellation, else
     /// only the vertex ranges that changed.
-    pub fn sync(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, mesh: &mut LiveMesh) {
-        let fresh = mesh.rebuilt
-            || self
-                .mesh
-                .as_ref()
-                .is_none_or(|m| m.vertex_count != mesh.vertex_count());
-        let dirty = mesh.take_dirty();
-        mesh.rebuilt = false;
-        if fresh {
-            self.mesh = Some(self.upload(device, mesh));
-            self.last_upload = std::mem::size_of_val(mesh.vertices()) + 4 * mesh.indices().len();
-            return;
+    /// Brings the GPU's copy of the mesh up to date: new buffers after a new tessellation, else
+    /// only the vertex ranges that changed; and the drag in progress (its rows once per drag, the
+    /// displacement every time). Returns whether anything the picture depends on changed.
+    pub fn sync(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &mut LiveMesh,
+        drag: Option<(u64, &[DragRow], Point3)>,
+    ) -> bool {
+        let mut new_group = false;
+        if let Some((id, rows, _)) = drag
+            && id != self.drag_id
+        {
+            self.drag_rows = drag_buffer(device, rows);
+            self.drag_id = id;
+            self.last_drag_upload = std::mem::size_of_val(rows);
+            new_group = true;
         }
-        let Some(buffers) = &self.mesh else { return };
-        let vertices = mesh.vertices();
-        let stride = std::mem::size_of::<ViewVertex>();
-        self.last_upload = 0;
-        if dirty.all {
-            queue.write_buffer(&buffers.vertices, 0, bytemuck::cast_slice(vertices));
-            self.last_upload = std::mem::size_of_val(vertices);
-            return;
+        let delta = drag.map_or([0.0; 4], |(_, _, d)| {
+            [d.x as f32, d.y as f32, d.z as f32, 0.0]
+        });
+        let moved = delta != self.drag_delta;
+        if moved {
+            queue.write_buffer(&self.drag_uniform, 0, bytemuck::cast_slice(&delta));
+            self.drag_delta = delta;
         }
-        for range in dirty.ranges {
-            let (start, end) = (
-                range.start as usize,
-                (range.end as usize).min(vertices.len()),
-            );
-            if start < end {
-                queue.write_buffer(
-                    &buffers.vertices,
-                    (start * stride) as u64,
-                    bytemuck::cast_slice(&vertices[start..end]),
-                );
-                self.last_upload += (end - start) * stride;
+        let count = mesh.vertex_count();
+        let new_buffers = self.mesh.as_ref().is_none_or(|m| m.vertex_count != count);
+        let written = match &self.mesh {
+            Some(buffers) if !new_buffers => mesh.upload(false, |offset, bytes| {
+                queue.write_buffer(&buffers.vertices, offset, bytes)
+            }),
+            _ => mesh.upload(true, |_, _| {}),
+        };
+        self.last_upload = match written {
+            Some(bytes) => bytes,
+            None => {
+                self.mesh = Some(self.upload(device, mesh));
+                std::mem::size_of_val(mesh.vertices()) + 4 * mesh.indices().len()
             }
+        };
+        if new_group
+            && written.is_some()
+            && let Some(buffers) = &mut self.mesh
+        {
+            buffers.group = mesh_group(
+                device,
+                &self.mesh_layout,
+                &buffers.vertices,
+                &buffers._indices,
+                &self.drag_rows,
+                &self.drag_uniform,
+            );
         }
+        new_group || moved || written != Some(0)
     }
 
     fn upload(&self, device: &wgpu::Device, mesh: &LiveMesh) -> MeshBuffers {
@@ -207,20 +263,14 @@ impl ViewportRenderer {
             contents: bytemuck::cast_slice(&nonempty(mesh.indices())),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ntori editor mesh"),
-            layout: &self.mesh_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: vertices.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: indices.as_entire_binding(),
-                },
-            ],
-        });
+        let group = mesh_group(
+            device,
+            &self.mesh_layout,
+            &vertices,
+            &indices,
+            &self.drag_rows,
+            &self.drag_uniform,
+        );
         MeshBuffers {
             vertices,
             _indices: indices,
@@ -360,6 +410,41 @@ impl ViewportRenderer {
     pub fn texture_view(&self) -> Option<&wgpu::TextureView> {
         self.targets.as_ref().map(|t| &t.resolved_view)
     }
+}
+
+fn mesh_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    vertices: &wgpu::Buffer,
+    indices: &wgpu::Buffer,
+    drag_rows: &wgpu::Buffer,
+    drag_uniform: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+        wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        }
+    }
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ntori editor mesh"),
+        layout,
+        entries: &[
+            entry(0, vertices),
+            entry(1, indices),
+            entry(2, drag_rows),
+            entry(3, drag_uniform),
+        ],
+    })
+}
+
+fn drag_buffer(device: &wgpu::Device, rows: &[DragRow]) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt as _;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("ntori editor drag rows"),
+        contents: bytemuck::cast_slice(&nonempty(rows)),
+        usage: wgpu::BufferUsages::STORAGE,
+    })
 }
 
 /// wgpu refuses empty buffers bound as storage: give it one zero element.

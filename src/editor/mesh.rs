@@ -14,7 +14,7 @@ use embedding::{ColumnIndex, Layout, Point3, Stencil};
 
 use super::camera::Ray;
 use super::pick::{Bvh, Hit};
-use crate::render::scene::{CHART_PALETTE, SURFACE_COLOUR, diverging, robust_range};
+use crate::render::scene::{SURFACE_COLOUR, diverging, robust_range};
 use crate::render::{CurvatureKind, Style};
 
 /// One vertex as the GPU's storage buffer holds it (32 bytes).
@@ -25,6 +25,7 @@ pub struct ViewVertex {
     pub normal: [f32; 3],
     /// RGBA, 8 bits each, red in the low byte.
     pub colour: u32,
+    /// 0, or 1 + the index of the drag row that moves this vertex during a drag.
     pub flags: u32,
 }
 
@@ -183,6 +184,47 @@ impl LiveMesh {
         d.normalize();
         d
     }
+    /// Hands what the GPU copy lacks to `write(byte offset, bytes)` (the vertex buffer's ranges that
+    /// changed), or, after a new tessellation or when `new_buffers`, tells the caller to make the
+    /// buffers anew from [`LiveMesh::vertices`] and [`LiveMesh::indices`]. Returns the bytes
+    /// written, or `None` for "make new buffers".
+    pub fn upload(
+        &mut self,
+        new_buffers: bool,
+        mut write: impl FnMut(u64, &[u8]),
+    ) -> Option<usize> {
+        let dirty = self.take_dirty();
+        if self.rebuilt || new_buffers {
+            self.rebuilt = false;
+            return None;
+        }
+        let stride = std::mem::size_of::<ViewVertex>();
+        if dirty.all {
+            write(0, bytemuck::cast_slice(&self.vertices));
+            return Some(self.vertices.len() * stride);
+        }
+        let mut bytes = 0;
+        for range in dirty.ranges {
+            let (start, end) = (
+                range.start as usize,
+                (range.end as usize).min(self.vertices.len()),
+            );
+            if start < end {
+                write(
+                    (start * stride) as u64,
+                    bytemuck::cast_slice(&self.vertices[start..end]),
+                );
+                bytes += (end - start) * stride;
+            }
+        }
+        Some(bytes)
+    }
+
+    /// Every vertex must be uploaded again.
+    pub fn mark_all_dirty(&mut self) {
+        self.dirty.all = true;
+    }
+
     pub(crate) fn mark_dirty(&mut self, rows: &[u32]) {
         self.dirty.add_sorted(rows);
     }
@@ -273,6 +315,7 @@ impl LiveMesh {
             let vertex = &mut self.vertices[r];
             vertex.position = [p.x as f32, p.y as f32, p.z as f32];
             vertex.normal = [n.x as f32, n.y as f32, n.z as f32];
+            vertex.flags = 0;
         }
         self.dirty.add_sorted(rows);
         self.bvh_stale = true;
@@ -288,7 +331,8 @@ impl LiveMesh {
                 .map(|&r| {
                     let mut c = [0.0f32; 3];
                     for (chart, b) in layout.blends(points[r as usize]) {
-                        let k = CHART_PALETTE[chart.index() % CHART_PALETTE.len()];
+                        let kind = layout.atlas().charts()[chart.index()].kind();
+                        let k = crate::palette::surface_rgb(kind);
                         for ch in 0..3 {
                             c[ch] += b as f32 * k[ch];
                         }

@@ -10,7 +10,7 @@ use embedding::fit::{FitSettings, vertex_areas};
 use embedding::{EmbeddingError, Layout, Model, Point3, SplineSettings};
 
 use super::camera::{OrbitCamera, to_point};
-use super::drag::DragPlan;
+use super::drag::{DragPlan, DragRow};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
@@ -408,14 +408,32 @@ impl EditorState {
         };
         let started = Instant::now();
         let layout = Layout::new(&self.atlas, self.settings)?;
-        drag.plan
-            .drag_to(&layout, target, &mut self.control, self.mesh.vertices_mut())?;
-        self.mesh.mark_dirty(&drag.plan.rows);
+        drag.plan.drag_to(&layout, target, &mut self.control)?;
         let took = started.elapsed();
         drag.events += 1;
         drag.busy += took;
         drag.last = took;
         Ok(())
+    }
+
+    /// The drag as the GPU shows it: the plan's id, the vertices it moves and how, and the
+    /// displacement of the last event.
+    pub fn drag_display(&self) -> Option<(u64, &[DragRow], Point3)> {
+        self.drag
+            .as_ref()
+            .map(|d| (d.plan.id, &d.plan.moves[..], d.plan.displacement))
+    }
+
+    /// The live mesh and the drag as the GPU shows it, together (for uploading both).
+    pub fn with_display<R>(
+        &mut self,
+        f: impl FnOnce(&mut LiveMesh, Option<(u64, &[DragRow], Point3)>) -> R,
+    ) -> R {
+        let drag = self
+            .drag
+            .as_ref()
+            .map(|d| (d.plan.id, &d.plan.moves[..], d.plan.displacement));
+        f(&mut self.mesh, drag)
     }
 
     /// Ends the drag: the moved vertices are recomputed exactly and the change joins the history.

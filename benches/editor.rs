@@ -1,0 +1,137 @@
+//! The editor's latencies at 10^5 and 10^6 vertices (genus 2, the default fitted model):
+//!
+//! - `drag_event`: one drag event as the editor runs it (`EditorState::drag_to_target`): the
+//!   minimum-norm solve (the dragged point, and the pins that share control points with it) and the
+//!   new control points; the vertices follow on the GPU from the displacement (see `drag.rs`);
+//! - `frame_prepare_drag`: the CPU side of a frame during a drag: one event, the camera's uniforms,
+//!   and whatever vertex ranges changed, copied out as the GPU upload would take them;
+//! - `cpu_vertex_update`: what the vertex shader does per frame during a drag (every reached
+//!   vertex's position and normal from the displacement), on the CPU, for comparison;
+//! - `frame_prepare_full`: a frame's copy-out with every vertex uploaded (after a style change);
+//! - `drag_start` and `drag_release`: what a press (planning the drag: gains of every reached
+//!   vertex) and a release (recomputing the moved rows exactly from the stencil) cost, once per
+//!   drag.
+
+use std::hint::black_box;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use embedding::fit::{FitSettings, initial_model};
+use embedding::{Model, Point3, SplineSettings};
+use ntori::editor::EditorState;
+use ntori::editor::state::Grab;
+use ntori::render::Style;
+
+/// t_e = t_r = t for about 10^5 and 10^6 vertices at genus 2 (V ≈ 20 t²).
+const SIZES: [(usize, u32); 2] = [(100_000, 71), (1_000_000, 224)];
+
+fn model() -> Model {
+    initial_model(2, 32, SplineSettings::default(), FitSettings::default())
+        .expect("the default model fits")
+        .model
+}
+
+/// A state at t, with two pins and the point to drag: three tessellation vertices spread over the
+/// surface.
+fn setup(model: &Model, t: u32) -> (EditorState, charts::ChartPoint) {
+    let mut state = EditorState::new(model, t, t).expect("the model opens");
+    let n = state.mesh().vertex_count();
+    let vertices = &state.mesh().tessellation.vertices;
+    let (dragged, pins) = (vertices[n / 3], [vertices[n / 7], vertices[n / 2]]);
+    for p in pins {
+        state.add_pin(p);
+    }
+    (state, dragged)
+}
+
+fn drag(c: &mut Criterion) {
+    let model = model();
+    let mut group = c.benchmark_group("editor");
+    group.sample_size(20);
+    for (n, t) in SIZES {
+        let (mut state, point) = setup(&model, t);
+        let start = state.surface_point(point);
+        let size = state.size();
+        state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+        let rows = state.drag().map_or(0, |d| d.plan.rows.len());
+        let controls = state.drag().map_or(0, |d| d.plan.touched.len());
+        println!(
+            "editor at {} vertices: a drag event moves {rows} vertices through {controls} control points",
+            state.mesh().vertex_count()
+        );
+        let mut step = 0u32;
+        let mut target = move || {
+            step = step.wrapping_add(1);
+            let s = f64::from(step % 100) / 100.0;
+            start + Point3::new(0.05 * s, -0.03 * s, 0.04 * s) * size
+        };
+        group.bench_function(BenchmarkId::new("drag_event", n), |b| {
+            b.iter(|| state.drag_to_target(black_box(target())).unwrap())
+        });
+        group.bench_function(BenchmarkId::new("frame_prepare_drag", n), |b| {
+            let mut staging: Vec<u8> = Vec::new();
+            b.iter(|| {
+                state.drag_to_target(target()).unwrap();
+                let uniforms = state.camera.uniforms(state.style(), [1280, 800]);
+                staging.clear();
+                let bytes = state
+                    .mesh_mut()
+                    .upload(false, |_, data| staging.extend_from_slice(data));
+                black_box((uniforms, bytes, staging.len()))
+            })
+        });
+        group.bench_function(BenchmarkId::new("drag_release", n), |b| {
+            b.iter_custom(|iters| {
+                let mut total = std::time::Duration::ZERO;
+                for _ in 0..iters {
+                    if state.drag().is_none() {
+                        state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+                    }
+                    state.drag_to_target(target()).unwrap();
+                    let started = std::time::Instant::now();
+                    state.release();
+                    total += started.elapsed();
+                }
+                total
+            })
+        });
+        state.release();
+        group.bench_function(BenchmarkId::new("drag_start", n), |b| {
+            b.iter_custom(|iters| {
+                let mut total = std::time::Duration::ZERO;
+                for _ in 0..iters {
+                    let started = std::time::Instant::now();
+                    state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+                    total += started.elapsed();
+                    state.cancel_drag();
+                }
+                total
+            })
+        });
+        // What the vertex shader does per frame during a drag, done on the CPU instead: every
+        // reached vertex's position and normal from the displacement.
+        state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+        let mut vertices = state.mesh().vertices().to_vec();
+        let plan = state.drag().unwrap().plan.clone();
+        group.bench_function(BenchmarkId::new("cpu_vertex_update", n), |b| {
+            b.iter(|| plan.move_vertices(black_box(target() - start), &mut vertices))
+        });
+        state.cancel_drag();
+        group.bench_function(BenchmarkId::new("frame_prepare_full", n), |b| {
+            let mut staging: Vec<u8> = Vec::new();
+            b.iter(|| {
+                // Every vertex dirty, as after a style change: the copy out is what is measured.
+                state.mesh_mut().mark_all_dirty();
+                let uniforms = state.camera.uniforms(Style::Shaded, [1280, 800]);
+                staging.clear();
+                let bytes = state
+                    .mesh_mut()
+                    .upload(false, |_, data| staging.extend_from_slice(data));
+                black_box((uniforms, bytes, staging.len()))
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, drag);
+criterion_main!(benches);
