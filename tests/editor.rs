@@ -15,7 +15,7 @@ use embedding::{Model, Point3, SplineSettings};
 use ntori::editor::camera::Ray;
 use ntori::editor::pick::cast_all;
 use ntori::editor::recovery::{RECOVERY_FORMAT, Recovery, RecoveryFile};
-use ntori::editor::{EditorApp, EditorOptions};
+use ntori::editor::{EditorApp, EditorOptions, EditorState};
 
 /// The default genus-2 model, fitted once for all tests.
 fn model() -> &'static Model {
@@ -48,6 +48,7 @@ fn harness() -> Harness<'static, EditorApp> {
         file: None,
         recovery_dir: None,
         tessellation: (24, 24),
+        native_dialogs: Some(false),
         ..EditorOptions::default()
     })
 }
@@ -564,4 +565,186 @@ fn ntori_edit_runs_under_xvfb() {
         info.height
     );
     println!("the window's viewport under Xvfb: {}", picture.display());
+}
+
+#[test]
+fn export_and_screenshot_through_the_file_prompt() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let dir = tempfile::tempdir().unwrap();
+    // File → Export mesh (Ctrl + E): the prompt, a path, the button; the export runs in the
+    // background.
+    let mesh_path = dir.path().join("surface.ply");
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::E);
+    harness.run();
+    harness
+        .get_by_label("File:")
+        .set_text_value_accesskit(mesh_path.to_str().unwrap());
+    harness.run();
+    harness.get_by_label("Export").click();
+    harness.run_steps(2);
+    harness.state_mut().wait_for_job();
+    harness.run();
+    assert!(mesh_path.exists(), "{:?}", harness.state().messages());
+    let (_, triangles) = ply_triangles(&mesh_path);
+    let state = harness.state().state().unwrap();
+    assert_eq!(triangles, state.mesh().triangle_count());
+    // F12: a screenshot of the viewport.
+    let png_path = dir.path().join("view.png");
+    harness.key_press(Key::F12);
+    harness.run();
+    harness
+        .get_by_label("File:")
+        .set_text_value_accesskit(png_path.to_str().unwrap());
+    harness.run();
+    harness.get_by_label("Save").click();
+    harness.run();
+    let png = std::fs::read(&png_path).expect("the screenshot was written");
+    assert_eq!(&png[1..4], b"PNG");
+}
+
+/// The vertex and face counts of a PLY header.
+fn ply_triangles(path: &std::path::Path) -> (usize, usize) {
+    let bytes = std::fs::read(path).unwrap();
+    let end = bytes.windows(10).position(|w| w == b"end_header").unwrap();
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    let count = |what: &str| {
+        header
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("element {what} ")))
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    (count("vertex"), count("face"))
+}
+
+#[test]
+fn new_settings_refit_the_surface_and_undo_restores_it() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let before = harness.state().state().unwrap().model();
+    // The side panel's grid size, then Apply: a refit in the background.
+    harness
+        .get_by_label("Grid per chart")
+        .set_value_accesskit(12.0);
+    harness.run();
+    harness.get_by_label("Apply").click();
+    harness.run_steps(2);
+    assert!(harness.state().busy());
+    harness.state_mut().wait_for_job();
+    harness.run();
+    let state = harness.state().state().unwrap();
+    assert_eq!(
+        state.settings().grid,
+        12,
+        "{:?}",
+        harness.state().messages()
+    );
+    assert_eq!(state.control().len(), 6 * 12 * 12);
+    // The refitted surface stays close to the old one.
+    let old = EditorState::new(&before, 24, 24).unwrap();
+    let worst = old
+        .mesh()
+        .positions()
+        .iter()
+        .zip(state.mesh().positions())
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(worst < 0.01 * old.size(), "moved by {worst}");
+    assert!(state.is_modified());
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    harness.run();
+    let state = harness.state().state().unwrap();
+    assert_eq!(
+        state.model(),
+        before,
+        "undo restores settings and control points"
+    );
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    harness.run();
+    assert_eq!(harness.state().state().unwrap().settings().grid, 12);
+}
+
+#[test]
+fn a_new_model_of_another_genus_from_the_dialog() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    harness.key_press_modifiers(Modifiers::COMMAND, Key::N);
+    harness.run();
+    harness.get_by_label("Genus").set_value_accesskit(1.0);
+    harness.run();
+    harness.get_by_label("Create").click();
+    harness.run_steps(2);
+    harness.state_mut().wait_for_job();
+    harness.run();
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.genus(), 1, "{:?}", harness.state().messages());
+    assert_eq!(state.path(), None);
+    assert!(!state.is_modified());
+    // Tessellation at the editor's setting: 4n·e² + 8n·e(2r − 1) triangles.
+    let (te, tr) = state.tessellation();
+    assert_eq!(
+        state.mesh().triangle_count() as u64,
+        charts::Tessellation::expected_triangles(1, te, tr)
+    );
+}
+
+#[test]
+fn every_style_and_a_control_net_drawn() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let dir = artefact_dir();
+    harness.key_press(Key::C);
+    harness.key_press(Key::C);
+    harness.run();
+    assert_eq!(
+        harness.state().state().unwrap().control_chart,
+        Some(charts::ChartId(1))
+    );
+    let mut pictures = Vec::new();
+    for (key, name) in [
+        (Key::Num1, "shaded"),
+        (Key::Num2, "wireframe"),
+        (Key::Num3, "charts"),
+        (Key::Num4, "gaussian"),
+        (Key::Num5, "mean"),
+    ] {
+        harness.key_press(key);
+        harness.run();
+        let image = harness.render().unwrap();
+        let path = dir.join(format!("style-{name}.png"));
+        image.save(&path).unwrap();
+        println!("{name}: {}", path.display());
+        pictures.push(harness.state().screenshot().unwrap().rgba);
+    }
+    for i in 0..pictures.len() {
+        for j in 0..i {
+            assert_ne!(pictures[i], pictures[j], "styles {i} and {j} look the same");
+        }
+    }
+}
+
+#[test]
+fn a_changed_tessellation_keeps_picking_exact() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    harness
+        .state_mut()
+        .state_mut()
+        .unwrap()
+        .set_tessellation(9, 5)
+        .unwrap();
+    harness.run();
+    let (k, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    let app = harness.state_mut();
+    let vertex = app.state().unwrap().mesh().tessellation.vertices[k];
+    let pick = app.state_mut().unwrap().pick(pixel).unwrap();
+    assert!(same_point(app, pick.point, vertex) < 1e-9);
+    let state = app.state().unwrap();
+    assert_eq!(
+        state.mesh().vertex_count() as u64,
+        charts::Tessellation::expected_vertices(2, 9, 5)
+    );
 }

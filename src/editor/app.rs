@@ -33,6 +33,9 @@ pub struct EditorOptions {
     /// writing the viewport's picture to `screenshot_on_exit` first (if set).
     pub exit_after_frames: Option<u32>,
     pub screenshot_on_exit: Option<PathBuf>,
+    /// Native file dialogs (rfd) or the in-window path prompt; None: native where a desktop portal
+    /// or zenity is there.
+    pub native_dialogs: Option<bool>,
 }
 
 impl Default for EditorOptions {
@@ -44,6 +47,7 @@ impl Default for EditorOptions {
             tessellation: (DEFAULT_T, DEFAULT_T),
             exit_after_frames: None,
             screenshot_on_exit: None,
+            native_dialogs: None,
         }
     }
 }
@@ -176,7 +180,8 @@ pub struct EditorApp {
     pending_screenshot: Option<PathBuf>,
     // Drafts for the side panel.
     draft_settings: SplineSettings,
-    draft_t: (u32, u32),
+    /// The tessellation sliders while they move (applied when let go).
+    draft_t: Option<(u32, u32)>,
     /// The tessellation used when the first model arrives.
     tessellation: (u32, u32),
     native_dialogs: bool,
@@ -215,9 +220,11 @@ impl EditorApp {
             close_now: false,
             pending_screenshot: None,
             draft_settings: SplineSettings::default(),
-            draft_t: options.tessellation,
+            draft_t: None,
             tessellation: options.tessellation,
-            native_dialogs: native_dialogs_available(),
+            native_dialogs: options
+                .native_dialogs
+                .unwrap_or_else(native_dialogs_available),
             frames: 0,
             exit_after_frames: options.exit_after_frames,
             screenshot_on_exit: options.screenshot_on_exit,
@@ -342,7 +349,7 @@ impl EditorApp {
         state.viewport = self.state.as_ref().map_or([800.0, 600.0], |s| s.viewport);
         state.frame();
         self.draft_settings = state.settings();
-        self.draft_t = state.tessellation();
+        self.draft_t = None;
         self.hover = None;
         self.selected = None;
         self.interaction = Interaction::None;
@@ -1053,7 +1060,7 @@ impl EditorApp {
 
         ui.separator();
         ui.label("Tessellation");
-        let (mut te, mut tr) = self.draft_t;
+        let (mut te, mut tr) = self.draft_t.unwrap_or(state.tessellation());
         let a = ui.add(
             egui::Slider::new(&mut te, 1..=MAX_T)
                 .logarithmic(true)
@@ -1064,7 +1071,9 @@ impl EditorApp {
                 .logarithmic(true)
                 .text("t_r"),
         );
-        self.draft_t = (te, tr);
+        if a.changed() || b.changed() {
+            self.draft_t = Some((te, tr));
+        }
         let vertices = charts::Tessellation::expected_vertices(state.genus(), te, tr);
         let triangles = charts::Tessellation::expected_triangles(state.genus(), te, tr);
         ui.label(format!(
@@ -1080,10 +1089,10 @@ impl EditorApp {
         }
         let released = !(a.dragged() || b.dragged());
         if released
-            && (te, tr) != state.tessellation()
-            && let Err(e) = state.set_tessellation(te, tr)
+            && let Some(t) = self.draft_t.take()
+            && t != state.tessellation()
+            && let Err(e) = state.set_tessellation(t.0, t.1)
         {
-            self.draft_t = state.tessellation();
             self.error(e.to_string());
             return;
         }
@@ -1572,8 +1581,10 @@ impl EditorApp {
             egui::Window::new(action.title())
                 .collapsible(false)
                 .show(ctx, |ui| {
-                    ui.label("File:");
-                    let edit = ui.add(egui::TextEdit::singleline(&mut text).desired_width(360.0));
+                    let label = ui.label("File:");
+                    let edit = ui
+                        .add(egui::TextEdit::singleline(&mut text).desired_width(360.0))
+                        .labelled_by(label.id);
                     let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(Key::Enter));
                     ui.horizontal(|ui| {
                         if ui.button(action.button()).clicked() || enter {

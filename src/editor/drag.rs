@@ -28,7 +28,7 @@ use embedding::{EmbeddingError, Layout, Point3};
 
 use bytemuck::{Pod, Zeroable};
 
-use super::mesh::{LiveMesh, ViewVertex};
+use super::mesh::{LiveMesh, ViewVertex, parallel_chunks};
 
 /// A vertex a drag moves, as the GPU reads it: its position and tangents when the drag began, and
 /// its gains (position = base + g Δ, S_u = u + g_u Δ, S_v = v + g_v Δ). 48 bytes.
@@ -155,32 +155,50 @@ impl DragPlan {
         touched.sort_unstable_by_key(|t| t.0);
         plan.touched = touched.iter().map(|t| t.0).collect();
         plan.beta = touched.iter().map(|t| t.1).collect();
-        // Gains: scatter each touched column into a per-vertex array, then gather the rows reached.
+        // The rows reached: a bit per vertex, set from the touched columns (small enough to stay in
+        // cache), read in increasing order.
         let n = mesh.vertex_count();
-        let mut dense = vec![[0.0f64; 3]; n];
-        let mut reached = vec![false; n];
-        for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
-            for (r, w) in mesh.stencil().column(mesh.columns(), c as usize) {
-                let g = &mut dense[r as usize];
-                for a in 0..3 {
-                    g[a] += w[a] * b;
-                }
-                reached[r as usize] = true;
+        let mut marks = vec![0u64; n.div_ceil(64)];
+        for &c in &plan.touched {
+            for &r in mesh.stencil().rows_of(mesh.columns(), c as usize) {
+                marks[r as usize / 64] |= 1 << (r % 64);
             }
         }
-        plan.rows = (0..n as u32).filter(|&r| reached[r as usize]).collect();
-        let (positions, tangents) = (mesh.positions(), mesh.tangents());
-        plan.moves = plan
-            .rows
+        plan.rows = marks
             .iter()
-            .map(|&r| {
-                let (p, [u, v]) = (positions[r as usize], tangents[r as usize]);
-                DragRow {
-                    base: [p.x, p.y, p.z, u.x, u.y, u.z, v.x, v.y, v.z].map(|x| x as f32),
-                    gain: dense[r as usize].map(|x| x as f32),
-                }
+            .enumerate()
+            .flat_map(|(w, &bits)| {
+                (0..64u32)
+                    .filter(move |b| bits & (1u64 << b) != 0)
+                    .map(move |b| (w * 64) as u32 + b)
             })
             .collect();
+        // Each reached row's gains from its own stencil row (streamed, in parallel), with β looked up
+        // by control point.
+        let mut beta = vec![0.0f64; control.len()];
+        for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
+            beta[c as usize] = b;
+        }
+        let (stencil, positions, tangents) = (mesh.stencil(), mesh.positions(), mesh.tangents());
+        plan.moves = vec![DragRow::default(); plan.rows.len()];
+        parallel_chunks(&plan.rows, &mut plan.moves, |rows, out| {
+            for (o, &r) in out.iter_mut().zip(rows) {
+                let mut g = [0.0f64; 3];
+                for (c, w) in stencil.row(r as usize) {
+                    let b = beta[c as usize];
+                    if b != 0.0 {
+                        for a in 0..3 {
+                            g[a] += w[a] * b;
+                        }
+                    }
+                }
+                let (p, [u, v]) = (positions[r as usize], tangents[r as usize]);
+                *o = DragRow {
+                    base: [p.x, p.y, p.z, u.x, u.y, u.z, v.x, v.y, v.z].map(|x| x as f32),
+                    gain: g.map(|x| x as f32),
+                };
+            }
+        });
         // Tell the GPU copy which vertices follow the drag (flags: the row's index + 1).
         let vertices = mesh.vertices_mut();
         for (k, &r) in plan.rows.iter().enumerate() {
