@@ -15,6 +15,7 @@ use embedding::{Model, Point3, SplineSettings};
 use ntori::editor::camera::Ray;
 use ntori::editor::pick::cast_all;
 use ntori::editor::recovery::{RECOVERY_FORMAT, Recovery, RecoveryFile};
+use ntori::editor::state::Grab;
 use ntori::editor::{EditorApp, EditorOptions, EditorState};
 
 /// The default genus-2 model, fitted once for all tests.
@@ -747,4 +748,104 @@ fn a_changed_tessellation_keeps_picking_exact() {
         state.mesh().vertex_count() as u64,
         charts::Tessellation::expected_vertices(2, 9, 5)
     );
+}
+
+#[test]
+fn the_influence_radius_widens_the_edit_and_keeps_the_constraints() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let (k, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    let (kp, _) = visible_vertex(harness.state_mut(), [0.56, 0.52]);
+    let state = harness.state_mut().state_mut().unwrap();
+    let (point, pin) = (
+        state.mesh().tessellation.vertices[k],
+        state.mesh().tessellation.vertices[kp],
+    );
+    state.add_pin(pin);
+    let pinned = state.surface_point(pin);
+    let size = state.size();
+    let mut moved = Vec::new();
+    for influence in [0.0, 0.25] {
+        state.influence = influence;
+        let before = state.control().to_vec();
+        state.start_drag(point, Grab::Surface, pixel).unwrap();
+        let target = state.surface_point(point) + Point3::new(0.02, 0.03, 0.08) * size;
+        state.drag_to_target(target).unwrap();
+        state.release();
+        assert!((state.surface_point(point) - target).norm() < 1e-6 * size);
+        assert!((state.surface_point(pin) - pinned).norm() < 1e-9);
+        moved.push(
+            before
+                .iter()
+                .zip(state.control())
+                .filter(|(a, b)| a != b)
+                .count(),
+        );
+        state.undo().unwrap();
+        assert_eq!(state.control(), &before[..]);
+    }
+    assert!(moved[1] > 2 * moved[0], "control points moved: {moved:?}");
+}
+
+#[test]
+fn escape_cancels_a_drag() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let before = harness.state().state().unwrap().control().to_vec();
+    let (_, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    let start = pos_of(harness.state(), pixel);
+    harness.hover_at(start);
+    harness.step();
+    harness.drag_at(start);
+    harness.step();
+    for i in 1..=4 {
+        harness.hover_at(start + Vec2::new(0.0, -10.0 * i as f32));
+        harness.step();
+    }
+    assert!(harness.state().state().unwrap().drag().is_some());
+    assert_ne!(harness.state().state().unwrap().control(), &before[..]);
+    harness.key_press(Key::Escape);
+    harness.step();
+    let state = harness.state().state().unwrap();
+    assert!(state.drag().is_none());
+    assert_eq!(state.control(), &before[..]);
+    assert!(
+        !state.history().can_undo(),
+        "a cancelled drag leaves no history"
+    );
+}
+
+#[test]
+fn the_wheel_zooms_and_trackpad_fingers_orbit() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let centre = harness.state().viewport_rect().center();
+    harness.hover_at(centre);
+    harness.step();
+    let before = harness.state().state().unwrap().camera;
+    let wheel = |unit, source, delta| Event::MouseWheel {
+        unit,
+        delta,
+        phase: egui::TouchPhase::Move,
+        source,
+        modifiers: Modifiers::NONE,
+    };
+    harness.event(wheel(
+        egui::MouseWheelUnit::Line,
+        egui::MouseWheelSource::Wheel,
+        Vec2::new(0.0, 2.0),
+    ));
+    harness.step();
+    let zoomed = harness.state().state().unwrap().camera;
+    assert!(zoomed.distance < before.distance);
+    assert_eq!(zoomed.azimuth, before.azimuth);
+    harness.event(wheel(
+        egui::MouseWheelUnit::Point,
+        egui::MouseWheelSource::Trackpad,
+        Vec2::new(30.0, 0.0),
+    ));
+    harness.step();
+    let turned = harness.state().state().unwrap().camera;
+    assert_ne!(turned.azimuth, zoomed.azimuth);
+    assert_eq!(turned.distance, zoomed.distance);
 }

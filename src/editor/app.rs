@@ -748,7 +748,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Left drag on a pin", "drag the pinned point"),
     ("Left drag elsewhere, Alt + left drag", "orbit"),
     ("Right or middle drag, Shift + left drag", "pan"),
-    ("Scroll, pinch, Ctrl + scroll", "zoom"),
+    ("Mouse wheel, pinch, Ctrl + scroll", "zoom"),
+    ("Two fingers on a trackpad", "orbit (with Shift: pan)"),
     ("Ctrl + click", "pin or unpin a point"),
     ("Double click", "orbit about the clicked point"),
     ("Esc", "cancel the drag in progress"),
@@ -1358,9 +1359,18 @@ impl EditorApp {
             state.camera.target = super::camera::to_glam(pick.surface);
         }
         if response.hovered() {
-            let (scroll, zoom) = ctx.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
-            if scroll != 0.0 {
-                state.camera.zoom((f64::from(scroll) / 300.0).exp());
+            let (wheels, zoom) = ctx.input(|i| (wheel_gestures(&i.events), i.zoom_delta()));
+            let height = state.viewport[1];
+            for gesture in wheels {
+                match gesture {
+                    Wheel::Zoom(factor) => state.camera.zoom(factor),
+                    Wheel::Orbit(d) => state
+                        .camera
+                        .orbit([-d[0] * f64::from(ppp), -d[1] * f64::from(ppp)], height),
+                    Wheel::Pan(d) => state
+                        .camera
+                        .pan([d[0] * f64::from(ppp), d[1] * f64::from(ppp)], height),
+                }
             }
             if zoom != 1.0 {
                 state.camera.zoom(f64::from(zoom));
@@ -1503,6 +1513,11 @@ impl EditorApp {
             && let Some(p) = project(state.surface_point(pick.point))
         {
             painter.circle_stroke(p, 6.0, Stroke::new(1.5, Color32::WHITE));
+        }
+        if let (Style::Curvature(kind), Some(range)) =
+            (state.style(), state.mesh().curvature_range())
+        {
+            curvature_legend(&painter, rect, kind, range);
         }
         if let Some(job) = &self.job {
             painter.text(
@@ -1727,6 +1742,99 @@ fn style_radio(ui: &mut egui::Ui, state: &mut EditorState) {
         "Mean curvature (5)",
     );
     state.set_style(style);
+}
+
+/// What a wheel or trackpad event does in the viewport.
+enum Wheel {
+    Zoom(f64),
+    Orbit([f64; 2]),
+    Pan([f64; 2]),
+}
+
+/// A mouse wheel zooms; two fingers on a trackpad orbit (with Shift: pan); pinching, or the wheel
+/// with Ctrl, zooms through egui's zoom delta (left out here).
+fn wheel_gestures(events: &[egui::Event]) -> Vec<Wheel> {
+    use egui::{MouseWheelSource, MouseWheelUnit};
+    events
+        .iter()
+        .filter_map(|e| match e {
+            egui::Event::MouseWheel {
+                unit,
+                delta,
+                source,
+                modifiers,
+                ..
+            } if !modifiers.command && !modifiers.ctrl => {
+                let (dx, dy) = (f64::from(delta.x), f64::from(delta.y));
+                let fingers = matches!(
+                    source,
+                    MouseWheelSource::Trackpad | MouseWheelSource::Momentum
+                ) || (*source == MouseWheelSource::Unknown
+                    && *unit == MouseWheelUnit::Point);
+                Some(if fingers && modifiers.shift {
+                    Wheel::Pan([dx, dy])
+                } else if fingers {
+                    Wheel::Orbit([dx, dy])
+                } else {
+                    let steps = match unit {
+                        MouseWheelUnit::Point => dy / 50.0,
+                        MouseWheelUnit::Line => dy,
+                        MouseWheelUnit::Page => 4.0 * dy,
+                    };
+                    Wheel::Zoom(1.15f64.powf(steps))
+                })
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// The curvature style's colour scale, at the viewport's right edge.
+fn curvature_legend(painter: &egui::Painter, rect: Rect, kind: CurvatureKind, range: f64) {
+    let bar = Rect::from_min_size(
+        Pos2::new(rect.right() - 70.0, rect.bottom() - 210.0),
+        Vec2::new(14.0, 160.0),
+    );
+    const STEPS: usize = 40;
+    let step = bar.height() / STEPS as f32;
+    for i in 0..STEPS {
+        let t = 1.0 - 2.0 * (i as f64 + 0.5) / STEPS as f64;
+        let [r, g, b] = crate::render::scene::diverging(t).map(|x| (x * 255.0).round() as u8);
+        painter.rect_filled(
+            Rect::from_min_size(
+                bar.min + Vec2::new(0.0, i as f32 * step),
+                Vec2::new(bar.width(), step + 0.5),
+            ),
+            0.0,
+            Color32::from_rgb(r, g, b),
+        );
+    }
+    let font = FontId::proportional(12.0);
+    let text = Color32::from_gray(225);
+    let title = match kind {
+        CurvatureKind::Gaussian => "K",
+        CurvatureKind::Mean => "H",
+    };
+    painter.text(
+        bar.center_top() - Vec2::new(0.0, 6.0),
+        Align2::CENTER_BOTTOM,
+        title,
+        font.clone(),
+        text,
+    );
+    for (y, value) in [
+        (bar.top(), range),
+        (bar.center().y, 0.0),
+        (bar.bottom(), -range),
+    ] {
+        painter.text(
+            Pos2::new(bar.right() + 5.0, y),
+            Align2::LEFT_CENTER,
+            format!("{value:+.3}"),
+            font.clone(),
+            text,
+        );
+    }
 }
 
 fn background() -> Color32 {

@@ -321,8 +321,8 @@ impl LiveMesh {
         self.bvh_stale = true;
     }
 
-    /// Colours of `rows` for the current style.
-    fn recolour(&mut self, layout: &Layout, control: &[Point3], rows: &[u32]) {
+    /// Colours of `rows` (increasing) for the current style.
+    pub fn recolour(&mut self, layout: &Layout, control: &[Point3], rows: &[u32]) {
         let points = &self.tessellation.vertices;
         let colours: Vec<u32> = match self.style {
             Style::Shaded | Style::Wireframe => vec![pack_colour(SURFACE_COLOUR); rows.len()],

@@ -452,7 +452,7 @@ impl EditorState {
             .unwrap_or_else(|_| unreachable!("checked settings"));
         self.mesh.recompute_rows(&self.control, &plan.rows);
         if matches!(self.mesh.style(), Style::Curvature(_)) {
-            self.mesh.controls_changed(&layout, &self.control, &moved);
+            self.mesh.recolour(&layout, &self.control, &plan.rows);
         }
         self.last_drag = Some(DragStats {
             point: plan.point,
