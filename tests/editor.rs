@@ -523,6 +523,7 @@ fn ntori_edit_runs_under_xvfb() {
         eprintln!("skipped: xvfb-run is not installed");
         return;
     }
+    let _gpu = gpu_lock();
     let dir = tempfile::tempdir().unwrap();
     let model_path = dir.path().join("model.json");
     ntori::model_file::save(&model_path, model()).unwrap();

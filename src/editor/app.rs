@@ -1379,6 +1379,22 @@ impl EditorApp {
         if self.interaction == Interaction::None {
             self.hover = response.hover_pos().and_then(|p| state.pick(to_pixel(p)));
         }
+        let cursor = match self.interaction {
+            Interaction::Edit => Some(egui::CursorIcon::Grabbing),
+            Interaction::Orbit | Interaction::Pan => Some(egui::CursorIcon::Move),
+            Interaction::None if response.hovered() => {
+                let on_pin = response.hover_pos().is_some_and(|p| {
+                    state
+                        .pin_near(to_pixel(p), super::state::PIN_RADIUS_PX)
+                        .is_some()
+                });
+                (on_pin || self.hover.is_some()).then_some(egui::CursorIcon::Grab)
+            }
+            Interaction::None => None,
+        };
+        if let Some(icon) = cursor {
+            ctx.set_cursor_icon(icon);
+        }
 
         // ---- the 3D picture
         match frame.wgpu_render_state() {
