@@ -23,7 +23,8 @@ fn model_text() -> &'static str {
         };
         let model = initial_model(2, 16, settings, FitSettings::default())
             .unwrap()
-            .model;
+            .surface
+            .to_model();
         serde_json::to_string(&model).unwrap()
     })
 }
@@ -211,11 +212,14 @@ fn too_many_triangles_are_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     // A genus-64 model need not be fitted to be refused: the count comes from t_e and t_r alone,
     // checked right after the model is read. Build a consistent (constant) genus-64 model.
-    let atlas = charts::Atlas::new(64).unwrap();
-    let layout = embedding::Layout::new(&atlas, SplineSettings::default()).unwrap();
-    let model = embedding::Model::constant(&layout, embedding::Point3::zeros());
+    let atlas = std::sync::Arc::new(charts::Atlas::new(64).unwrap());
+    let count = embedding::Layout::new(&atlas, SplineSettings::default())
+        .unwrap()
+        .control_count();
+    let control = vec![embedding::Point3::zeros(); count];
+    let model = embedding::Surface::new(atlas, SplineSettings::default(), control).unwrap();
     let path = dir.path().join("big.json");
-    ntori::model_file::save(&path, &model).unwrap();
+    ntori::io::model_file::save(&path, &model).unwrap();
     let out = dir.path().join("big.stl");
     let start = std::time::Instant::now();
     ntori()

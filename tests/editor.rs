@@ -391,7 +391,7 @@ fn save_then_open_round_trips_exactly() {
     assert_eq!(opened, saved, "bit for bit");
     assert_eq!(state.path(), Some(path.as_path()));
     assert!(!state.is_modified());
-    assert_eq!(ntori::model_file::load(&path).unwrap(), saved);
+    assert_eq!(ntori::io::model_file::load(&path).unwrap(), saved);
 }
 
 #[test]
@@ -526,7 +526,7 @@ fn ntori_edit_runs_under_xvfb() {
     let _gpu = gpu_lock();
     let dir = tempfile::tempdir().unwrap();
     let model_path = dir.path().join("model.json");
-    ntori::model_file::save(&model_path, model()).unwrap();
+    ntori::io::model_file::save(&model_path, model()).unwrap();
     let picture = artefact_dir().join("xvfb-window-viewport.png");
     let _ = std::fs::remove_file(&picture);
     let runtime = dir.path().join("runtime");

@@ -7,16 +7,16 @@ use std::io::Cursor;
 use std::sync::OnceLock;
 
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Model, SplineSettings};
-use ntori::export::{
+use embedding::{Model, SplineSettings, Surface};
+use ntori::io::export::{
     self, Encoding, ExportError, Format, MAX_RESOLUTION, SurfaceMesh, surface_mesh,
 };
-use ntori::mesh::HalfEdgeMesh;
-use ntori::model_file::{self, ModelFileError};
+use mesh::HalfEdgeMesh;
+use ntori::io::model_file::{self, ModelFileError};
 
 /// Small fitted models (coarse grid and input mesh: seconds, not minutes), genus 0 to 3.
-fn models() -> &'static [Model] {
-    static MODELS: OnceLock<Vec<Model>> = OnceLock::new();
+fn models() -> &'static [Surface] {
+    static MODELS: OnceLock<Vec<Surface>> = OnceLock::new();
     MODELS.get_or_init(|| {
         (0..=3)
             .map(|genus| {
@@ -26,7 +26,7 @@ fn models() -> &'static [Model] {
                 };
                 initial_model(genus, 16, settings, FitSettings::default())
                     .unwrap()
-                    .model
+                    .surface
             })
             .collect()
     })
@@ -464,7 +464,7 @@ fn off_reads_back_with_a_plain_parser() {
 #[test]
 fn the_surface_mesh_has_the_tessellations_size_and_analytic_outward_normals() {
     for (model, mesh) in models().iter().zip(meshes()) {
-        let genus = model.genus;
+        let genus = model.genus();
         let t = charts::Atlas::new(genus)
             .unwrap()
             .tessellate(16, 16)
@@ -492,10 +492,13 @@ fn the_surface_mesh_has_the_tessellations_size_and_analytic_outward_normals() {
 
 #[test]
 fn a_mirrored_model_is_still_exported_outward() {
-    let mut model = models()[2].clone();
-    for p in &mut model.control_points {
-        p[0] = -p[0];
-    }
+    let original = &models()[2];
+    let mirrored = original
+        .control_points()
+        .iter()
+        .map(|p| embedding::Point3::new(-p.x, p.y, p.z))
+        .collect();
+    let model = original.with_control_points(mirrored).unwrap();
     let mesh = surface_mesh(&model, 16, 16).unwrap();
     let read = ReadBack {
         positions: mesh.positions.clone(),
@@ -523,28 +526,20 @@ fn bad_resolutions_and_degenerate_surfaces_are_refused() {
         ));
     }
     // Within range but absurd: refused from the formula, before any work.
-    let big = embedding::Model {
-        genus: 64,
-        ..model.clone()
-    };
     let err = export::check_resolution(64, 512, 512).unwrap_err();
     assert!(matches!(err, ExportError::TooManyTriangles { .. }), "{err}");
     assert!(err.to_string().contains("triangles"));
-    assert!(matches!(
-        surface_mesh(&big, 512, 512),
-        Err(ExportError::TooManyTriangles { .. })
-    ));
-    // A model whose control points do not match its settings.
-    let mut short = model.clone();
+    // A model whose control points do not match its settings never becomes a surface.
+    let mut short = model.to_model();
     short.control_points.pop();
     assert!(matches!(
-        surface_mesh(&short, 4, 4),
-        Err(ExportError::Model(_))
+        Surface::from_model(&short),
+        Err(embedding::EmbeddingError::ControlCount { .. })
     ));
     // Every control point in one place: no surface to export.
-    let atlas = charts::Atlas::new(2).unwrap();
-    let layout = embedding::Layout::new(&atlas, model.settings).unwrap();
+    let layout = model.layout();
     let point = Model::constant(&layout, embedding::Point3::new(1.0, 2.0, 3.0));
+    let point = Surface::from_model(&point).unwrap();
     let err = surface_mesh(&point, 4, 4).unwrap_err();
     assert!(matches!(err, ExportError::Degenerate { .. }), "{err}");
 }
@@ -610,7 +605,7 @@ fn model_files_round_trip_and_report_what_is_wrong() {
 fn a_failed_write_leaves_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("out.obj");
-    let err = ntori::files::write_atomically_with(&path, |w| {
+    let err = ntori::io::atomic::write_atomically_with(&path, |w| {
         w.write_all(b"partial")?;
         Err(std::io::Error::other("the disk is full"))
     })
@@ -619,7 +614,7 @@ fn a_failed_write_leaves_no_file() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     // And an existing file is kept as it was.
     std::fs::write(&path, b"before").unwrap();
-    let _ = ntori::files::write_atomically_with(&path, |_| Err(std::io::Error::other("no")));
+    let _ = ntori::io::atomic::write_atomically_with(&path, |_| Err(std::io::Error::other("no")));
     assert_eq!(std::fs::read(&path).unwrap(), b"before");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }

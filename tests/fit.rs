@@ -7,8 +7,8 @@ use embedding::fit::{FitSettings, cut, initial_model, parameterize};
 use embedding::holed::HoledMesh;
 use embedding::integrals::surface_integrals;
 use embedding::{Layout, SplineSettings, Stencil};
-use ntori::mesh::HalfEdgeMesh;
-use ntori::spatial::{MeshRef, bounding_box_diagonal, hausdorff, self_intersections};
+use mesh::HalfEdgeMesh;
+use mesh::spatial::{MeshRef, bounding_box_diagonal, hausdorff, self_intersections};
 
 fn arrays(points: &[embedding::Point3]) -> Vec<[f64; 3]> {
     points.iter().map(|p| [p.x, p.y, p.z]).collect()
@@ -161,7 +161,7 @@ fn fitted_surfaces_are_close_immersed_embedded_and_satisfy_gauss_bonnet() {
         let fit = initial_model(genus, 32, settings, FitSettings::default()).unwrap();
         let atlas = Atlas::new(genus).unwrap();
         let layout = Layout::new(&atlas, settings).unwrap();
-        let control = fit.model.points();
+        let control = fit.surface.control_points().to_vec();
         let surface = |te: u32| {
             let t = atlas.tessellate(te, te).unwrap();
             let stencil = Stencil::build(&layout, &t.vertices);

@@ -12,7 +12,7 @@ fn model() -> Model {
     };
     initial_model(2, 16, settings, FitSettings::default())
         .unwrap()
-        .model
+        .surface
 }
 
 fn offscreen() -> Offscreen {
@@ -203,12 +203,10 @@ fn impossible_requests_are_errors() {
             Err(RenderError::View(_))
         ));
     }
-    let mut broken = model.clone();
+    // A model that does not match its settings never becomes a surface to render.
+    let mut broken = model.to_model();
     broken.control_points.pop();
-    assert!(
-        gpu.render_model(&broken, &options(Style::Shaded), &[])
-            .is_err()
-    );
+    assert!(embedding::Surface::from_model(&broken).is_err());
     assert!(
         gpu.render_mesh_png(&[[0.0; 3]], &[[0, 1, 2]], &options(Style::Shaded))
             .is_err()

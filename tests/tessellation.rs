@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use charts::check::consistency_at;
 use charts::{Atlas, Geometry, Tessellation};
-use ntori::mesh::HalfEdgeMesh;
+use mesh::HalfEdgeMesh;
 
 const RESOLUTIONS: [u32; 6] = [1, 2, 3, 4, 8, 16];
 

@@ -50,7 +50,7 @@ fn main() {
         // Where is the worst vertex?
         let atlas = charts::Atlas::new(genus).unwrap();
         let layout = embedding::Layout::new(&atlas, settings).unwrap();
-        let control = fit.model.points();
+        let control = fit.surface.control_points().to_vec();
         let mut errs: Vec<(f64, usize)> = fit
             .parameterization
             .points

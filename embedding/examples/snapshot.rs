@@ -45,7 +45,7 @@ fn main() {
         let layout = Layout::new(&atlas, settings).unwrap();
         let t = atlas.tessellate(24, 24).unwrap();
         let stencil = Stencil::build(&layout, &t.vertices);
-        let control = fit.model.points();
+        let control = fit.surface.control_points().to_vec();
         let mut pos = vec![Point3::zeros(); t.vertices.len()];
         let mut nor = pos.clone();
         stencil.positions(&control, &mut pos);

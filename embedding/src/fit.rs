@@ -22,6 +22,7 @@
 //! ```
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use charts::{Atlas, ChartId, ChartPoint, Geometry, Lft, ModelPoint, Polygon};
 use faer::Mat;
@@ -30,7 +31,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use num_complex::Complex64;
 
 use crate::holed::HoledMesh;
-use crate::model::Model;
+use crate::spline_surface::Surface;
 use crate::surface::{Layout, Point3, SplineSettings};
 use crate::{EmbeddingError, floater};
 
@@ -110,7 +111,7 @@ impl Default for FitSettings {
 /// A fitted model and how well it fits.
 #[derive(Clone, Debug)]
 pub struct InitialFit {
-    pub model: Model,
+    pub surface: Surface,
     pub mesh: HoledMesh,
     pub parameterization: Parameterization,
     /// Root mean square and largest distance |S(p_i) − P_i| over the mesh vertices.
@@ -127,7 +128,7 @@ pub fn initial_model(
     settings: SplineSettings,
     fit_settings: FitSettings,
 ) -> Result<InitialFit, EmbeddingError> {
-    let atlas = Atlas::new(genus)?;
+    let atlas = Arc::new(Atlas::new(genus)?);
     let layout = Layout::new(&atlas, settings)?;
     let mesh = HoledMesh::new(genus, resolution)?;
     let parameterization = parameterize(
@@ -144,15 +145,15 @@ pub fn initial_model(
         &weights,
         fit_settings,
     )?;
-    let model = Model::from_points(&layout, &control);
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (p, target) in parameterization.points.iter().zip(&mesh.positions) {
         let e = (layout.eval(&control, *p).pos - target).norm();
         sum += e * e;
         max = max.max(e);
     }
+    let surface = Surface::new(Arc::clone(&atlas), settings, control)?;
     Ok(InitialFit {
-        model,
+        surface,
         rms_residual: (sum / mesh.positions.len() as f64).sqrt(),
         max_residual: max,
         mesh_diagonal: diagonal(&mesh.positions),

@@ -23,15 +23,19 @@
 
 pub mod bspline;
 pub mod edit;
+pub mod evaluate;
 pub mod fit;
 pub mod floater;
 pub mod holed;
 pub mod integrals;
 pub mod model;
+pub mod spline_surface;
 pub mod stencil;
 pub mod surface;
 
+pub use evaluate::{Curvatures, Sample, SampleSink, Wants, evaluate, evaluate_rows};
 pub use model::{MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader};
+pub use spline_surface::{ControlId, Surface};
 pub use stencil::{ColumnIndex, Stencil};
 pub use surface::{Jet, Layout, Point3, SplineSettings, SurfaceJet, Weight};
 

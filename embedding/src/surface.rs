@@ -178,6 +178,23 @@ impl<'a> Layout<'a> {
         })
     }
 
+    /// A layout from settings [`Layout::new`] has accepted before (their basis is `basis`).
+    pub(crate) fn from_checked(
+        atlas: &'a Atlas,
+        basis: UniformBasis,
+        settings: SplineSettings,
+    ) -> Layout<'a> {
+        Layout {
+            atlas,
+            basis,
+            settings,
+        }
+    }
+
+    pub(crate) fn basis(&self) -> UniformBasis {
+        self.basis
+    }
+
     pub fn atlas(&self) -> &'a Atlas {
         self.atlas
     }

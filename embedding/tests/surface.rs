@@ -525,3 +525,99 @@ fn curvature_and_normals_do_not_depend_on_the_chart() {
         );
     }
 }
+
+/// A surface of `genus` with pseudo-random control points.
+fn noisy_surface(genus: u32, seed: u64) -> embedding::Surface {
+    let atlas = std::sync::Arc::new(Atlas::new(genus).unwrap());
+    let settings = SplineSettings {
+        grid: 6,
+        ..SplineSettings::default()
+    };
+    let control = noisy_controls(&Layout::new(&atlas, settings).unwrap(), seed);
+    embedding::Surface::new(atlas, settings, control).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The one evaluation path: `evaluate` (stencils per chunk) and `evaluate_rows` (a kept
+    /// stencil) hand the sink the same samples, in index order, equal to direct evaluation.
+    #[test]
+    fn the_evaluation_path_agrees_with_direct_evaluation(
+        genus in prop::sample::select(vec![0u32, 1, 2, 3, 5, 8]),
+        seed in any::<u64>(),
+        units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..300),
+    ) {
+        let surface = noisy_surface(genus, seed);
+        let points: Vec<ChartPoint> = units
+            .iter()
+            .map(|&(a, b, c)| chart_point(surface.atlas(), a, b, c))
+            .collect();
+        let wants = embedding::Wants { curvature: true, blends: true };
+        let mut all = Vec::new();
+        embedding::evaluate(&surface, &points, wants, 0.0, &mut |s: &embedding::Sample| {
+            all.push(s.clone())
+        });
+        prop_assert_eq!(all.len(), points.len());
+        let layout = surface.layout();
+        for (i, s) in all.iter().enumerate() {
+            prop_assert_eq!(s.index, i);
+            let direct = surface.eval(points[i]);
+            prop_assert!((s.position - direct.pos).norm() <= 1e-12);
+            prop_assert!((s.du - direct.du).norm() <= 1e-9 * (1.0 + direct.du.norm()));
+            let cross = s.du.cross(&s.dv);
+            prop_assert!((cross - direct.du.cross(&direct.dv)).norm() <= 1e-9 * (1.0 + cross.norm()));
+            match s.normal {
+                Some(m) => prop_assert!((m - cross / cross.norm()).norm() <= 1e-15),
+                None => prop_assert!(cross.norm() == 0.0),
+            }
+            let k = s.curvature.unwrap();
+            prop_assert_eq!(k.gaussian, direct.gaussian_curvature());
+            prop_assert_eq!(&s.blends, &layout.blends(points[i]));
+        }
+        // Every other row through a kept stencil: the very same numbers.
+        let stencil = Stencil::build(&layout, &points);
+        let rows: Vec<u32> = (0..points.len() as u32).step_by(2).collect();
+        let mut some = Vec::new();
+        embedding::evaluate_rows(&surface, &stencil, &points, &rows, wants, 0.0, &mut |s: &embedding::Sample| {
+            some.push(s.clone())
+        });
+        prop_assert_eq!(some.len(), rows.len());
+        for (s, &r) in some.iter().zip(&rows) {
+            prop_assert_eq!(s, &all[r as usize]);
+        }
+    }
+}
+
+#[test]
+fn surfaces_are_validated_once_when_built() {
+    let surface = noisy_surface(2, 7);
+    // Round trip through the document.
+    let model = surface.to_model();
+    assert_eq!(embedding::Surface::from_model(&model).unwrap(), surface);
+    // Wrong counts and non-finite points are refused, and leave the surface as it was.
+    let mut short = surface.control_points().to_vec();
+    short.pop();
+    assert!(matches!(
+        surface.with_control_points(short),
+        Err(embedding::EmbeddingError::ControlCount { .. })
+    ));
+    let mut edited = surface.clone();
+    let bad = [
+        (embedding::ControlId(3), Point3::new(1.0, 2.0, 3.0)),
+        (embedding::ControlId(5), Point3::new(f64::NAN, 0.0, 0.0)),
+    ];
+    assert_eq!(
+        edited.set_control_points_at(bad),
+        Err(embedding::EmbeddingError::NotFinite(5))
+    );
+    assert_eq!(edited, surface);
+    let good = [(embedding::ControlId(3), Point3::new(1.0, 2.0, 3.0))];
+    edited.set_control_points_at(good).unwrap();
+    assert_eq!(edited.control_points()[3], Point3::new(1.0, 2.0, 3.0));
+    assert_ne!(edited, surface);
+    // A model of another genus than its control points fits is refused.
+    let mut other = model.clone();
+    other.genus = 3;
+    assert!(embedding::Surface::from_model(&other).is_err());
+}

@@ -11,7 +11,7 @@ use egui::{
     Sense, Stroke, Vec2,
 };
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Model, Point3, SplineSettings};
+use embedding::{Point3, SplineSettings, Surface};
 
 use super::gpu::ViewportRenderer;
 use super::recovery::{Orphan, Recovery};
@@ -23,7 +23,7 @@ use crate::render::{CurvatureKind, Style};
 pub struct EditorOptions {
     /// A model to start with (and the file it came from); without one, the default genus-2 model
     /// is fitted in the background.
-    pub model: Option<Model>,
+    pub model: Option<Surface>,
     pub file: Option<PathBuf>,
     /// Where autosaves go and crash recovery looks (None: no autosave).
     pub recovery_dir: Option<PathBuf>,
@@ -59,7 +59,7 @@ const NEW_MODEL_RESOLUTION: usize = 32;
 enum JobOutput {
     NewModel {
         genus: u32,
-        result: Result<Model, String>,
+        result: Result<Surface, String>,
     },
     Refit {
         settings: SplineSettings,
@@ -233,7 +233,7 @@ impl EditorApp {
         };
         match options.model {
             Some(model) => {
-                match EditorState::new(&model, options.tessellation.0, options.tessellation.1) {
+                match EditorState::new(model, options.tessellation.0, options.tessellation.1) {
                     Ok(mut state) => {
                         state.set_path(options.file);
                         app.install(state);
@@ -327,7 +327,8 @@ impl EditorApp {
             return Err(EditorError::Other("no such recovery file".into()));
         };
         let (te, tr) = self.current_t();
-        let mut state = EditorState::new(&orphan.file.model, te, tr)?;
+        let surface = Surface::from_model(&orphan.file.model)?;
+        let mut state = EditorState::new(surface, te, tr)?;
         state.set_path(orphan.file.original.clone());
         state.mark_modified();
         self.install(state);
@@ -375,7 +376,7 @@ impl EditorApp {
                 settings,
                 FitSettings::default(),
             )
-            .map(|fit| fit.model)
+            .map(|fit| fit.surface)
             .map_err(|e| e.to_string());
             let _ = sender.send(JobOutput::NewModel { genus, result });
         });
@@ -388,10 +389,10 @@ impl EditorApp {
 
     fn start_refit(&mut self, settings: SplineSettings) {
         let Some(state) = &self.state else { return };
-        let model = state.model();
+        let surface = state.surface().clone();
         let (sender, receiver) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
-            let result = refit(&model, settings).map_err(|e| e.to_string());
+            let result = refit(&surface, settings).map_err(|e| e.to_string());
             let _ = sender.send(JobOutput::Refit { settings, result });
         });
         self.job = Some(Job {
@@ -406,14 +407,14 @@ impl EditorApp {
 
     fn start_export(&mut self, path: PathBuf) {
         let Some(state) = &self.state else { return };
-        let model = state.model();
+        let surface = state.surface().clone();
         let (te, tr) = state.tessellation();
         let (sender, receiver) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
             let result = (|| -> Result<String, EditorError> {
-                let format = crate::export::Format::from_path(&path)?;
-                let mesh = crate::export::surface_mesh(&model, te, tr)?;
-                crate::export::write(&mesh, &path, format, crate::export::Encoding::Binary)?;
+                let format = crate::io::export::Format::from_path(&path)?;
+                let mesh = crate::io::export::surface_mesh(&surface, te, tr)?;
+                crate::io::export::write(&mesh, &path, format, crate::io::export::Encoding::Binary)?;
                 Ok(format!(
                     "exported {} triangles to {}",
                     mesh.triangles.len(),
@@ -450,7 +451,7 @@ impl EditorApp {
             JobOutput::NewModel { genus, result } => match result {
                 Ok(model) => {
                     let (te, tr) = self.current_t();
-                    match EditorState::new(&model, te, tr) {
+                    match EditorState::new(model, te, tr) {
                         Ok(state) => {
                             self.install(state);
                             self.info(format!("new genus-{genus} model"));
@@ -497,7 +498,7 @@ impl EditorApp {
         }
         let result = recovery.autosave(
             state.history().state(),
-            || state.model(),
+            || state.surface().to_model(),
             state.path(),
             force,
         );
@@ -568,7 +569,7 @@ impl EditorApp {
                 }
                 FileAction::Export => dialog.add_filter(
                     "Mesh",
-                    &crate::export::Format::ALL.map(crate::export::Format::extension),
+                    &crate::io::export::Format::ALL.map(crate::io::export::Format::extension),
                 ),
                 FileAction::Screenshot => dialog.add_filter("PNG image", &["png"]),
             };
@@ -1464,7 +1465,7 @@ impl EditorApp {
                     .atlas()
                     .charts()
                     .get(chart.index())
-                    .map_or([0.8; 3], |k| crate::palette::stroke_rgb(k.kind()));
+                    .map_or([0.8; 3], |k| crate::render::palette::stroke_rgb(k.kind()));
                 Color32::from_rgb(
                     (c[0] * 255.0) as u8,
                     (c[1] * 255.0) as u8,
@@ -1718,7 +1719,7 @@ impl EditorApp {
         let result = self
             .screenshot()
             .and_then(|image| Ok(image.to_png()?))
-            .and_then(|png| Ok(crate::files::write_atomically(&path, &png)?));
+            .and_then(|png| Ok(crate::io::atomic::write_atomically(&path, &png)?));
         match result {
             Ok(()) => self.info(format!("saved a screenshot to {}", path.display())),
             Err(e) => self.error(format!("screenshot failed: {e}")),

@@ -24,11 +24,12 @@
 
 use charts::ChartPoint;
 use embedding::edit::{Constraint, solve};
-use embedding::{EmbeddingError, Layout, Point3};
+use embedding::{ControlId, EmbeddingError, Layout, Point3, Surface};
 
 use bytemuck::{Pod, Zeroable};
 
-use super::mesh::{LiveMesh, ViewVertex, parallel_chunks};
+use super::mesh::{LiveMesh, ViewVertex};
+use embedding::evaluate::parallel_chunks;
 
 /// A vertex a drag moves, as the GPU reads it: its position and tangents when the drag began, and
 /// its gains (position = base + g Δ, S_u = u + g_u Δ, S_v = v + g_v Δ). 48 bytes.
@@ -71,13 +72,14 @@ impl DragPlan {
     /// Plans a drag of `point` with `pins` held, from the current control points; `radius` (0: off)
     /// is the influence radius in model units.
     pub fn new(
-        layout: &Layout,
+        surface: &Surface,
         mesh: &mut LiveMesh,
-        control: &[Point3],
         point: ChartPoint,
         pins: &[ChartPoint],
         radius: f64,
     ) -> Result<DragPlan, EmbeddingError> {
+        let layout = &surface.layout();
+        let control = surface.control_points();
         let start_position = layout.eval(control, point).pos;
         let soft: Vec<(u32, f64)> = if radius > 0.0 {
             control
@@ -252,20 +254,18 @@ impl DragPlan {
     /// One drag event: the dragged point's new target. Solves and writes the new control points
     /// into `control` (start + change, for the touched ones); the vertices follow on the GPU from
     /// [`DragPlan::displacement`]. Returns the residual.
-    pub fn drag_to(
-        &mut self,
-        layout: &Layout,
-        target: Point3,
-        control: &mut [Point3],
-    ) -> Result<f64, EmbeddingError> {
+    pub fn drag_to(&mut self, surface: &mut Surface, target: Point3) -> Result<f64, EmbeddingError> {
         let delta = target - self.start_position;
-        let (moved, residual) = self.solve(layout, delta)?;
-        for &c in &self.touched {
-            control[c as usize] = self.start_control[c as usize];
-        }
+        let (moved, residual) = self.solve(&surface.layout(), delta)?;
+        let mut updates: Vec<(ControlId, Point3)> = self
+            .touched
+            .iter()
+            .map(|&c| (ControlId(c), self.start_control[c as usize]))
+            .collect();
         for (c, d) in moved {
-            control[c as usize] = self.start_control[c as usize] + d;
+            updates.push((ControlId(c), self.start_control[c as usize] + d));
         }
+        surface.set_control_points_at(updates.iter().copied())?;
         self.displacement = delta;
         self.residual = residual;
         Ok(residual)

@@ -10,11 +10,11 @@ use std::ops::Range;
 
 use bytemuck::{Pod, Zeroable};
 use charts::Tessellation;
-use embedding::{ColumnIndex, Layout, Point3, Stencil};
+use embedding::{ColumnIndex, Point3, Sample, Stencil, Surface, Wants, evaluate_rows};
 
 use super::camera::Ray;
 use super::pick::{Bvh, Hit};
-use crate::render::scene::{SURFACE_COLOUR, diverging, robust_range};
+use crate::render::scene::{SURFACE_COLOUR, blend_colour, diverging, robust_range};
 use crate::render::{CurvatureKind, Style};
 
 /// One vertex as the GPU's storage buffer holds it (32 bytes).
@@ -108,15 +108,14 @@ pub struct LiveMesh {
 impl LiveMesh {
     /// Tessellates, builds the stencil and evaluates every vertex.
     pub fn new(
-        layout: &Layout,
-        control: &[Point3],
+        surface: &Surface,
         te: u32,
         tr: u32,
         style: Style,
     ) -> Result<LiveMesh, charts::ChartsError> {
-        let tessellation = layout.atlas().tessellate(te, tr)?;
-        let stencil = Stencil::build(layout, &tessellation.vertices);
-        let columns = stencil.column_index(layout.control_count());
+        let tessellation = surface.atlas().tessellate(te, tr)?;
+        let stencil = Stencil::build(&surface.layout(), &tessellation.vertices);
+        let columns = stencil.column_index(surface.control_points().len());
         let n = tessellation.vertices.len();
         let indices = tessellation.triangles.iter().flatten().copied().collect();
         let mut mesh = LiveMesh {
@@ -139,8 +138,7 @@ impl LiveMesh {
             marks: vec![0; n.div_ceil(64)],
         };
         let all: Vec<u32> = (0..n as u32).collect();
-        mesh.recompute_rows(control, &all);
-        mesh.set_style(layout, control, style);
+        mesh.evaluate(surface, &all, true);
         mesh.bvh = Bvh::build(&mesh.positions, &mesh.tessellation.triangles);
         mesh.bvh_stale = false;
         Ok(mesh)
@@ -260,11 +258,11 @@ impl LiveMesh {
     }
 
     /// Recolours every vertex for `style`.
-    pub fn set_style(&mut self, layout: &Layout, control: &[Point3], style: Style) {
+    pub fn set_style(&mut self, surface: &Surface, style: Style) {
         self.style = style;
         self.curvature_range = None;
         let all: Vec<u32> = (0..self.positions.len() as u32).collect();
-        self.recolour(layout, control, &all);
+        self.evaluate(surface, &all, true);
         self.dirty.all = true;
     }
 
@@ -289,81 +287,62 @@ impl LiveMesh {
 
     /// After `controls` changed: recomputes exactly the rows they touch (and their colours in the
     /// curvature style), marks them for upload and the picking boxes for refitting.
-    pub fn controls_changed(&mut self, layout: &Layout, control: &[Point3], controls: &[u32]) {
+    pub fn controls_changed(&mut self, surface: &Surface, controls: &[u32]) {
         let rows = self.rows_of_controls(controls);
-        self.recompute_rows(control, &rows);
-        if matches!(self.style, Style::Curvature(_)) {
-            self.recolour(layout, control, &rows);
-        }
+        self.rows_changed(surface, &rows);
     }
 
-    /// Positions and tangents of `rows` (increasing) from the stencil, their GPU vertices, marked
-    /// dirty; the picking boxes are stale afterwards.
-    pub fn recompute_rows(&mut self, control: &[Point3], rows: &[u32]) {
-        let stencil = &self.stencil;
-        let mut jets = vec![[Point3::zeros(); 3]; rows.len()];
-        parallel_chunks(rows, &mut jets, |rows, out| {
-            for (o, &r) in out.iter_mut().zip(rows) {
-                *o = stencil.position_and_tangents(control, r as usize);
-            }
-        });
-        for (&r, [p, u, v]) in rows.iter().zip(jets) {
-            let r = r as usize;
-            self.positions[r] = p;
-            self.tangents[r] = [u, v];
+    /// After the control points under `rows` (increasing) changed: their positions, tangents and,
+    /// in the curvature style, colours anew.
+    pub fn rows_changed(&mut self, surface: &Surface, rows: &[u32]) {
+        let recolour = matches!(self.style, Style::Curvature(_));
+        self.evaluate(surface, rows, recolour);
+    }
+
+    /// Positions and tangents of `rows` (increasing) through the one evaluation path, their GPU
+    /// vertices (and colours, when `recolour`), marked dirty; the picking boxes are stale
+    /// afterwards.
+    fn evaluate(&mut self, surface: &Surface, rows: &[u32], recolour: bool) {
+        let style = self.style;
+        let wants = Wants {
+            curvature: recolour && matches!(style, Style::Curvature(_)),
+            blends: recolour && style == Style::Charts,
+        };
+        let atlas = surface.atlas();
+        let (positions, tangents, vertices) =
+            (&mut self.positions, &mut self.tangents, &mut self.vertices);
+        let mut values = Vec::new();
+        let sink = &mut |s: &Sample| {
+            let (p, u, v) = (s.position, s.du, s.dv);
+            positions[s.index] = p;
+            tangents[s.index] = [u, v];
             let n = u.cross(&v).normalize();
-            let vertex = &mut self.vertices[r];
+            let vertex = &mut vertices[s.index];
             vertex.position = [p.x as f32, p.y as f32, p.z as f32];
             vertex.normal = [n.x as f32, n.y as f32, n.z as f32];
             vertex.flags = 0;
+            match (recolour, style, s.curvature) {
+                (false, ..) => {}
+                (_, Style::Curvature(kind), Some(k)) => values.push(match kind {
+                    CurvatureKind::Gaussian => k.gaussian,
+                    CurvatureKind::Mean => k.mean,
+                }),
+                (_, Style::Charts, _) => vertex.colour = pack_colour(blend_colour(atlas, &s.blends)),
+                _ => vertex.colour = pack_colour(SURFACE_COLOUR),
+            }
+        };
+        let points = &self.tessellation.vertices;
+        evaluate_rows(surface, &self.stencil, points, rows, wants, 0.0, sink);
+        if !values.is_empty() {
+            let range = *self
+                .curvature_range
+                .get_or_insert_with(|| robust_range(&values));
+            for (&r, v) in rows.iter().zip(values) {
+                self.vertices[r as usize].colour = pack_colour(diverging(v / range));
+            }
         }
         self.dirty.add_sorted(rows);
         self.bvh_stale = true;
-    }
-
-    /// Colours of `rows` (increasing) for the current style.
-    pub fn recolour(&mut self, layout: &Layout, control: &[Point3], rows: &[u32]) {
-        let points = &self.tessellation.vertices;
-        let colours: Vec<u32> = match self.style {
-            Style::Shaded | Style::Wireframe => vec![pack_colour(SURFACE_COLOUR); rows.len()],
-            Style::Charts => rows
-                .iter()
-                .map(|&r| {
-                    let mut c = [0.0f32; 3];
-                    for (chart, b) in layout.blends(points[r as usize]) {
-                        let kind = layout.atlas().charts()[chart.index()].kind();
-                        let k = crate::palette::surface_rgb(kind);
-                        for ch in 0..3 {
-                            c[ch] += b as f32 * k[ch];
-                        }
-                    }
-                    pack_colour(c)
-                })
-                .collect(),
-            Style::Curvature(kind) => {
-                let mut values = vec![0.0; rows.len()];
-                parallel_chunks(rows, &mut values, |rows, out| {
-                    for (o, &r) in out.iter_mut().zip(rows) {
-                        let s = layout.eval(control, points[r as usize]);
-                        *o = match kind {
-                            CurvatureKind::Gaussian => s.gaussian_curvature(),
-                            CurvatureKind::Mean => s.mean_curvature(),
-                        };
-                    }
-                });
-                let range = *self
-                    .curvature_range
-                    .get_or_insert_with(|| robust_range(&values));
-                values
-                    .iter()
-                    .map(|&v| pack_colour(diverging(v / range)))
-                    .collect()
-            }
-        };
-        for (&r, c) in rows.iter().zip(colours) {
-            self.vertices[r as usize].colour = c;
-        }
-        self.dirty.add_sorted(rows);
     }
 
     /// The curvature style's colour range (95th percentile of |curvature| when the style was set).
@@ -380,29 +359,4 @@ fn bounds(points: &[Point3]) -> (Point3, Point3) {
         ),
         |(lo, hi), p| (lo.inf(p), hi.sup(p)),
     )
-}
-
-/// Runs `work` over matching chunks of `input` and `output` on the available cores (one chunk when
-/// there is little to do).
-pub fn parallel_chunks<T: Sync, U: Send>(
-    input: &[T],
-    output: &mut [U],
-    work: impl Fn(&[T], &mut [U]) + Sync,
-) {
-    const MIN_PER_THREAD: usize = 16_384;
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(input.len().div_ceil(MIN_PER_THREAD))
-        .max(1);
-    if threads == 1 {
-        work(input, output);
-        return;
-    }
-    let per = input.len().div_ceil(threads);
-    std::thread::scope(|scope| {
-        for (i, o) in input.chunks(per).zip(output.chunks_mut(per)) {
-            let work = &work;
-            scope.spawn(move || work(i, o));
-        }
-    });
 }

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use embedding::Model;
 use serde::{Deserialize, Serialize};
 
-use crate::files::{FileError, write_atomically};
+use crate::io::atomic::{FileError, write_atomically};
 
 /// The recovery file's format name.
 pub const RECOVERY_FORMAT: &str = "ntori-recovery";

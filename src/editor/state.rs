@@ -7,14 +7,14 @@ use std::time::{Duration, Instant};
 
 use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
 use embedding::fit::{FitSettings, vertex_areas};
-use embedding::{EmbeddingError, Layout, Model, Point3, SplineSettings};
+use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
 use super::camera::{OrbitCamera, to_point};
 use super::drag::{DragPlan, DragRow};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
-use crate::model_file::{self, ModelFileError};
+use crate::io::model_file::{self, ModelFileError};
 use crate::render::Style;
 
 /// What can go wrong in the editor.
@@ -27,11 +27,11 @@ pub enum EditorError {
     #[error(transparent)]
     File(#[from] ModelFileError),
     #[error(transparent)]
-    Export(#[from] crate::export::ExportError),
+    Export(#[from] crate::io::export::ExportError),
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
     #[error(transparent)]
-    Io(#[from] crate::files::FileError),
+    Io(#[from] crate::io::atomic::FileError),
     #[error("t_e = {te}, t_r = {tr} is out of the editor's range (1 to {max} each)")]
     Tessellation { te: u32, tr: u32, max: u32 },
     #[error("{0}")]
@@ -95,9 +95,8 @@ pub struct DragStats {
 
 /// The editor's state (see the module documentation).
 pub struct EditorState {
-    atlas: Atlas,
-    settings: SplineSettings,
-    control: Vec<Point3>,
+    /// The document's surface: validated once, when it was loaded, fitted or refitted.
+    surface: Surface,
     mesh: LiveMesh,
     te: u32,
     tr: u32,
@@ -117,24 +116,18 @@ pub struct EditorState {
 }
 
 impl EditorState {
-    /// A state for `model`, tessellated at t_e, t_r, with the default view.
-    pub fn new(model: &Model, te: u32, tr: u32) -> Result<EditorState, EditorError> {
+    /// A state for `surface`, tessellated at t_e, t_r, with the default view.
+    pub fn new(surface: Surface, te: u32, tr: u32) -> Result<EditorState, EditorError> {
         check_t(te, tr)?;
-        let atlas = Atlas::new(model.genus)?;
-        let layout = Layout::new(&atlas, model.settings)?;
-        model.validate(&layout)?;
-        let control = model.points();
-        let mesh = LiveMesh::new(&layout, &control, te, tr, Style::Shaded)?;
+        let mesh = LiveMesh::new(&surface, te, tr, Style::Shaded)?;
         let (centre, radius) = mesh.bounding_sphere();
         Ok(EditorState {
-            settings: model.settings,
             camera: OrbitCamera::new(centre, radius),
             viewport: [800.0, 600.0],
-            control,
+            surface,
             mesh,
             te,
             tr,
-            atlas,
             pins: Vec::new(),
             drag: None,
             history: History::new(),
@@ -148,44 +141,40 @@ impl EditorState {
 
     /// Opens a model file.
     pub fn open(path: &Path, te: u32, tr: u32) -> Result<EditorState, EditorError> {
-        let model = model_file::load(path)?;
-        let mut state = EditorState::new(&model, te, tr)?;
+        let surface = crate::io::model_file::load(path)?;
+        let mut state = EditorState::new(surface, te, tr)?;
         state.path = Some(path.to_owned());
         Ok(state)
     }
 
     /// Writes the model to `path` and makes it the document's file.
     pub fn save(&mut self, path: &Path) -> Result<(), EditorError> {
-        model_file::save(path, &self.model())?;
+        crate::io::model_file::save(path, &self.surface)?;
         self.path = Some(path.to_owned());
         self.saved_state = self.history.state();
         Ok(())
     }
 
-    /// The model as it stands.
-    pub fn model(&self) -> Model {
-        match Layout::new(&self.atlas, self.settings) {
-            Ok(layout) => Model::from_points(&layout, &self.control),
-            // The settings were checked when they were set.
-            Err(_) => unreachable!("checked spline settings"),
-        }
+    /// The surface as it stands.
+    pub fn surface(&self) -> &Surface {
+        &self.surface
     }
 
     pub fn layout(&self) -> Layout<'_> {
-        Layout::new(&self.atlas, self.settings).unwrap_or_else(|_| unreachable!("checked settings"))
+        self.surface.layout()
     }
 
     pub fn atlas(&self) -> &Atlas {
-        &self.atlas
+        self.surface.atlas()
     }
     pub fn genus(&self) -> u32 {
-        self.atlas.genus()
+        self.surface.genus()
     }
     pub fn settings(&self) -> SplineSettings {
-        self.settings
+        self.surface.settings()
     }
     pub fn control(&self) -> &[Point3] {
-        &self.control
+        self.surface.control_points()
     }
     pub fn mesh(&self) -> &LiveMesh {
         &self.mesh
@@ -230,16 +219,14 @@ impl EditorState {
 
     /// The exact surface point at a chart point.
     pub fn surface_point(&self, p: ChartPoint) -> Point3 {
-        self.layout().eval(&self.control, p).pos
+        self.surface.eval(p).pos
     }
 
     // ------------------------------------------------------------------------------- display
 
     pub fn set_style(&mut self, style: Style) {
         if style != self.mesh.style() {
-            let layout = Layout::new(&self.atlas, self.settings)
-                .unwrap_or_else(|_| unreachable!("checked settings"));
-            self.mesh.set_style(&layout, &self.control, style);
+            self.mesh.set_style(&self.surface, style);
         }
     }
 
@@ -249,8 +236,7 @@ impl EditorState {
         if (te, tr) == (self.te, self.tr) {
             return Ok(());
         }
-        let layout = self.layout();
-        let mesh = LiveMesh::new(&layout, &self.control, te, tr, self.mesh.style())?;
+        let mesh = LiveMesh::new(&self.surface, te, tr, self.mesh.style())?;
         self.mesh = mesh;
         (self.te, self.tr) = (te, tr);
         Ok(())
@@ -283,7 +269,7 @@ impl EditorState {
         let ray = self.camera.ray(pixel, self.viewport);
         let hit = self.mesh.cast(&ray)?;
         let point = hit.chart_point(&self.mesh.tessellation);
-        let manifold = self.atlas.locate(point).ok()?;
+        let manifold = self.surface.atlas().locate(point).ok()?;
         Some(Pick {
             hit,
             point,
@@ -369,8 +355,7 @@ impl EditorState {
             .map(|(_, &p)| p)
             .collect();
         let radius = self.influence * self.size();
-        let layout = Layout::new(&self.atlas, self.settings)?;
-        let plan = DragPlan::new(&layout, &mut self.mesh, &self.control, point, &pins, radius)?;
+        let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, radius)?;
         self.drag = Some(Drag {
             plan,
             press_pixel: pixel,
@@ -407,8 +392,7 @@ impl EditorState {
             return Ok(());
         };
         let started = Instant::now();
-        let layout = Layout::new(&self.atlas, self.settings)?;
-        drag.plan.drag_to(&layout, target, &mut self.control)?;
+        drag.plan.drag_to(&mut self.surface, target)?;
         let took = started.elapsed();
         drag.events += 1;
         drag.busy += took;
@@ -446,14 +430,9 @@ impl EditorState {
             .touched
             .iter()
             .copied()
-            .filter(|&c| self.control[c as usize] != plan.start_control[c as usize])
+            .filter(|&c| self.control()[c as usize] != plan.start_control[c as usize])
             .collect();
-        let layout = Layout::new(&self.atlas, self.settings)
-            .unwrap_or_else(|_| unreachable!("checked settings"));
-        self.mesh.recompute_rows(&self.control, &plan.rows);
-        if matches!(self.mesh.style(), Style::Curvature(_)) {
-            self.mesh.recolour(&layout, &self.control, &plan.rows);
-        }
+        self.mesh.rows_changed(&self.surface, &plan.rows);
         self.last_drag = Some(DragStats {
             point: plan.point,
             start: plan.start_position,
@@ -478,7 +457,7 @@ impl EditorState {
                     .iter()
                     .map(|&c| plan.start_control[c as usize])
                     .collect(),
-                after: moved.iter().map(|&c| self.control[c as usize]).collect(),
+                after: moved.iter().map(|&c| self.control()[c as usize]).collect(),
                 indices: moved,
             },
         );
@@ -489,10 +468,12 @@ impl EditorState {
         let Some(drag) = self.drag.take() else {
             return;
         };
-        for &c in &drag.plan.touched {
-            self.control[c as usize] = drag.plan.start_control[c as usize];
+        let start = &drag.plan.start_control;
+        let restored = drag.plan.touched.iter().map(|&c| (ControlId(c), start[c as usize]));
+        // The starting control points were valid, so restoring them cannot fail.
+        if self.surface.set_control_points_at(restored).is_ok() {
+            self.mesh.rows_changed(&self.surface, &drag.plan.rows);
         }
-        self.mesh.recompute_rows(&self.control, &drag.plan.rows);
     }
 
     // ------------------------------------------------------------------------------- history
@@ -538,11 +519,9 @@ impl EditorState {
                 after,
             } => {
                 let values = if forward { after } else { before };
-                for (&c, v) in indices.iter().zip(values) {
-                    self.control[c as usize] = *v;
-                }
-                let layout = Layout::new(&self.atlas, self.settings)?;
-                self.mesh.controls_changed(&layout, &self.control, indices);
+                let updates = indices.iter().zip(values).map(|(&c, &v)| (ControlId(c), v));
+                self.surface.set_control_points_at(updates)?;
+                self.mesh.controls_changed(&self.surface, indices);
             }
             Change::Settings { before, after } => {
                 let (settings, control) = if forward { after } else { before };
@@ -558,7 +537,7 @@ impl EditorState {
         settings: SplineSettings,
         control: Vec<Point3>,
     ) -> Result<(), EditorError> {
-        let before = (self.settings, self.control.clone());
+        let before = (self.settings(), self.control().to_vec());
         self.replace_control(settings, control.clone())?;
         self.history.push(
             format!(
@@ -578,14 +557,12 @@ impl EditorState {
         settings: SplineSettings,
         control: Vec<Point3>,
     ) -> Result<(), EditorError> {
-        let layout = Layout::new(&self.atlas, settings)?;
-        Model::from_points(&layout, &control).validate(&layout)?;
-        let mesh = LiveMesh::new(&layout, &control, self.te, self.tr, self.mesh.style())?;
-        self.settings = settings;
-        self.control = control;
+        let surface = Surface::new(self.surface.shared_atlas(), settings, control)?;
+        let mesh = LiveMesh::new(&surface, self.te, self.tr, self.mesh.style())?;
+        self.surface = surface;
         self.mesh = mesh;
         if let Some(c) = self.control_chart
-            && c.index() >= self.atlas.charts().len()
+            && c.index() >= self.atlas().charts().len()
         {
             self.control_chart = None;
         }
@@ -594,9 +571,10 @@ impl EditorState {
 
     /// The control points of one chart, as a grid × grid net (row j, column i at j·grid + i).
     pub fn control_net(&self, chart: ChartId) -> &[Point3] {
-        let g = self.settings.grid;
+        let g = self.settings().grid;
         let start = chart.index() * g * g;
-        &self.control[start..(start + g * g).min(self.control.len())]
+        let control = self.control();
+        &control[start..(start + g * g).min(control.len())]
     }
 
     /// Where a viewport pixel's ray meets the surface, as text for the status bar.
@@ -627,18 +605,18 @@ fn check_t(te: u32, tr: u32) -> Result<(), EditorError> {
 /// A model's control points for other spline settings: the new layout fitted (least squares, as the
 /// initial fit does) to the current surface sampled at a tessellation's vertices. Returns the
 /// control points and the largest distance between the two surfaces at the samples.
-pub fn refit(model: &Model, settings: SplineSettings) -> Result<(Vec<Point3>, f64), EditorError> {
-    let atlas = Atlas::new(model.genus)?;
-    let old = Layout::new(&atlas, model.settings)?;
-    model.validate(&old)?;
-    let new = Layout::new(&atlas, settings)?;
+pub fn refit(
+    surface: &Surface,
+    settings: SplineSettings,
+) -> Result<(Vec<Point3>, f64), EditorError> {
+    let atlas = surface.atlas();
+    let new = Layout::new(atlas, settings)?;
     // About four samples per control point along each side of a chart.
-    let t = (2 * settings.grid.max(model.settings.grid)).clamp(16, 96) as u32;
+    let t = (2 * settings.grid.max(surface.settings().grid)).clamp(16, 96) as u32;
     let tessellation = atlas.tessellate(t, t)?;
-    let control = model.points();
-    let stencil = embedding::Stencil::build(&old, &tessellation.vertices);
+    let stencil = embedding::Stencil::build(&surface.layout(), &tessellation.vertices);
     let mut targets = vec![Point3::zeros(); stencil.rows()];
-    stencil.positions(&control, &mut targets);
+    stencil.positions(surface.control_points(), &mut targets);
     let weights = vertex_areas(&targets, &tessellation.triangles);
     let fitted = embedding::fit::fit(
         &new,

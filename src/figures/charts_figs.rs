@@ -85,7 +85,7 @@ fn draw_disk_and_polygon(doc: &mut Doc, atlas: &Atlas, frame: Frame, outline_id:
         frame.scale,
         "fill=\"none\" stroke=\"#888888\" stroke-width=\"1.2\"",
     );
-    let outline = crate::tessellate::polygon_path(poly, |z| frame.px(z));
+    let outline = super::drawing::polygon_path(poly, |z| frame.px(z));
     doc.clip(outline_id, &outline);
     doc.path(&outline, "fill=\"#f4f4f4\" stroke=\"none\"");
     outline

@@ -14,11 +14,12 @@ use std::path::{Path, PathBuf};
 
 use charts::{Atlas, ChartsError};
 
-use crate::files::{FileError, write_atomically};
+use crate::io::atomic::{FileError, write_atomically};
 
 mod charts_figs;
+pub mod drawing;
 mod geometry;
-pub use crate::palette;
+pub use crate::render::palette;
 mod polygons;
 pub mod renderings;
 mod svg;

@@ -142,7 +142,7 @@ pub fn figure3(atlas: &Atlas, poly: &Polygon) -> String {
         "fill=\"none\" stroke=\"#333333\" stroke-width=\"1.5\"",
     );
     // The polygon, and the squares of edge charts a₁ and b₁ clipped to it.
-    let outline = crate::tessellate::polygon_path(poly, |z| frame.px(z));
+    let outline = super::drawing::polygon_path(poly, |z| frame.px(z));
     doc.clip("fig3-polygon", &outline);
     doc.path(&outline, "fill=\"#f4f4f4\" stroke=\"none\"");
     if let Some(half) = atlas.tessellation_square_half() {

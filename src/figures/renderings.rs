@@ -7,7 +7,7 @@
 use charts::{Atlas, ChartPoint, ModelPoint};
 use embedding::edit::{Constraint, solve};
 use embedding::fit::{FitSettings, InitialFit, initial_model};
-use embedding::{Layout, Model, Point3, SplineSettings};
+use embedding::{Point3, SplineSettings, Surface};
 
 use super::geometry::side_points;
 use super::{Figure, FiguresError, GENUS, palette};
@@ -56,7 +56,7 @@ impl Studio {
 
     fn render(
         &mut self,
-        model: &Model,
+        model: &Surface,
         options: &RenderOptions,
         curves: &[Curve],
         figure: &str,
@@ -125,10 +125,8 @@ const PLATE_VIEW: View = View {
 
 /// The loops a_k, b_k on the surface: each polygon side e = 4k + t (t = 0, 1) sampled as a geodesic
 /// of the disk, located on the surface (in the chart that holds it deepest) and evaluated.
-pub fn loops(model: &Model) -> Result<Vec<Curve>, embedding::EmbeddingError> {
-    let atlas = Atlas::new(model.genus)?;
-    let layout = Layout::new(&atlas, model.settings)?;
-    let control = model.points();
+pub fn loops(surface: &Surface) -> Result<Vec<Curve>, embedding::EmbeddingError> {
+    let atlas = surface.atlas();
     let Some(poly) = atlas.polygon() else {
         return Ok(Vec::new());
     };
@@ -143,7 +141,7 @@ pub fn loops(model: &Model) -> Result<Vec<Curve>, embedding::EmbeddingError> {
                         |q: &ChartPoint| atlas.charts()[q.chart.index()].domain().margin(q.coords);
                     margin(a).total_cmp(&margin(b))
                 })?;
-                let s = layout.eval(&control, *best).pos;
+                let s = surface.eval(*best).pos;
                 Some([s.x, s.y, s.z])
             })
             .collect();
@@ -273,10 +271,9 @@ fn bounds(p: &[Point3]) -> (Point3, Point3) {
 fn edited(
     fit: &InitialFit,
     script: &Scripted,
-) -> Result<(Model, String), embedding::EmbeddingError> {
-    let atlas = Atlas::new(fit.model.genus)?;
-    let layout = Layout::new(&atlas, fit.model.settings)?;
-    let mut control = fit.model.points();
+) -> Result<(Surface, String), embedding::EmbeddingError> {
+    let layout = fit.surface.layout();
+    let mut control = fit.surface.control_points().to_vec();
     let at = |i: usize| fit.parameterization.points[i];
     let mut constraints: Vec<Constraint> = script
         .moved
@@ -311,7 +308,7 @@ fn edited(
         list(&mut script.pinned.iter().copied()),
         edit.residual
     );
-    Ok((Model::from_points(&layout, &control), text))
+    Ok((fit.surface.with_control_points(control)?, text))
 }
 
 /// Makes one 3D figure with the studio's renderer and models.
@@ -339,7 +336,7 @@ pub fn jobs() -> Vec<Job3d> {
         file: "fig2b-loops.png".into(),
         make: Box::new(|studio| {
             let fit = studio.fit(GENUS, "2")?;
-            let model = fit.model.clone();
+            let model = fit.surface.clone();
             let curves = loops(&model).map_err(embedding_error("2"))?;
             let o = options(MAIN, PLATE_VIEW, Style::Shaded);
             let bytes = studio.render(&model, &o, &curves, "2")?;
@@ -386,7 +383,7 @@ pub fn jobs() -> Vec<Job3d> {
         file: "fig6b-fitted.png".into(),
         make: Box::new(|studio| {
             let fit = studio.fit(GENUS, "6")?;
-            let (model, rms, diag) = (fit.model.clone(), fit.rms_residual, fit.mesh_diagonal);
+            let (model, rms, diag) = (fit.surface.clone(), fit.rms_residual, fit.mesh_diagonal);
             let o = options(MAIN, PLATE_VIEW, Style::Shaded);
             let bytes = studio.render(&model, &o, &[], "6")?;
             Ok(png(
@@ -434,7 +431,7 @@ pub fn jobs() -> Vec<Job3d> {
         jobs.push(Job3d {
             file: file.clone(),
             make: Box::new(move |studio| {
-                let model = studio.fit(genus, "gallery")?.model.clone();
+                let model = studio.fit(genus, "gallery")?.surface.clone();
                 let view = if genus >= 2 {
                     PLATE_VIEW
                 } else {
@@ -471,7 +468,7 @@ pub fn jobs() -> Vec<Job3d> {
         jobs.push(Job3d {
             file: file.into(),
             make: Box::new(move |studio| {
-                let model = studio.fit(GENUS, "gallery")?.model.clone();
+                let model = studio.fit(GENUS, "gallery")?.surface.clone();
                 let o = options(GALLERY, PLATE_VIEW, style);
                 let bytes = studio.render(&model, &o, &[], "gallery")?;
                 Ok(png(

@@ -6,14 +6,17 @@
 //! coloured by its blend weights, one colour per chart); curvature (Gaussian or mean curvature on a
 //! diverging scale, with a legend).
 
+pub mod camera;
 pub mod gpu;
 mod legend;
+pub mod palette;
 pub mod scene;
 
-use embedding::Model;
+use embedding::Surface;
 
 use gpu::{DEPTH_FORMAT, GpuScene, SurfaceRenderer};
-use scene::{Camera, SceneGeometry};
+use camera::Camera;
+use scene::SceneGeometry;
 
 /// What can go wrong when rendering.
 #[derive(Debug, thiserror::Error)]
@@ -210,7 +213,7 @@ impl Offscreen {
     /// The model's surface, tessellated at `options.tessellation`, as PNG bytes.
     pub fn render_model_png(
         &mut self,
-        model: &Model,
+        model: &Surface,
         options: &RenderOptions,
         curves: &[Curve],
     ) -> Result<Vec<u8>, RenderError> {
@@ -220,7 +223,7 @@ impl Offscreen {
     /// The model's surface as an image.
     pub fn render_model(
         &mut self,
-        model: &Model,
+        model: &Surface,
         options: &RenderOptions,
         curves: &[Curve],
     ) -> Result<Image, RenderError> {

@@ -2,78 +2,11 @@
 //! and the curve segments. Shared by offscreen rendering and the editor.
 
 use charts::Atlas;
-use embedding::{Layout, Model, Point3, Stencil};
-use glam::{Mat4, Vec3};
+use embedding::{Sample, Surface, Wants, evaluate};
+use glam::Vec3;
 
-use super::gpu::{FrameUniforms, Segment, SurfaceVertex};
-use super::{CurvatureKind, Curve, RenderError, Style, View};
-
-/// Where the camera looks from: the bounding sphere of what is drawn and a [`View`] around it.
-#[derive(Clone, Copy, Debug)]
-pub struct Camera {
-    pub centre: Vec3,
-    pub radius: f32,
-    pub view: View,
-    pub aspect: f32,
-}
-
-/// The vertical field of view.
-const FOV_DEG: f32 = 34.0;
-
-impl Camera {
-    /// Unit vector from the centre towards the eye (z is up).
-    pub fn direction(&self) -> Vec3 {
-        let (az, el) = (
-            (self.view.azimuth_deg as f32).to_radians(),
-            (self.view.elevation_deg as f32).to_radians(),
-        );
-        Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())
-    }
-
-    pub fn eye(&self) -> Vec3 {
-        self.centre + self.direction() * self.radius * self.view.distance as f32
-    }
-
-    pub fn view_proj(&self) -> Mat4 {
-        let eye = self.eye();
-        // Looking straight down or up, z cannot be "up": use y then.
-        let up = if self.direction().z.abs() > 0.999 {
-            Vec3::Y
-        } else {
-            Vec3::Z
-        };
-        let distance = (eye - self.centre).length();
-        let near = (distance - 1.5 * self.radius).max(1e-3 * distance);
-        let far = distance + 1.5 * self.radius;
-        Mat4::perspective_rh(FOV_DEG.to_radians(), self.aspect, near, far)
-            * Mat4::look_at_rh(eye, self.centre, up)
-    }
-
-    /// The key light: above and to the left of the camera, towards the light.
-    pub fn light(&self) -> Vec3 {
-        let back = self.direction();
-        let right = Vec3::Z.cross(back).try_normalize().unwrap_or(Vec3::X);
-        let up = back.cross(right);
-        (back + 0.8 * up - 0.5 * right).normalize()
-    }
-
-    pub fn uniforms(&self, style: Style, size: (u32, u32)) -> FrameUniforms {
-        let wire = matches!(style, Style::Wireframe);
-        FrameUniforms {
-            view_proj: self.view_proj().to_cols_array_2d(),
-            eye: self.eye().extend(1.0).to_array(),
-            light: self.light().extend(0.0).to_array(),
-            params: [f32::from(u8::from(wire)), 1.2, 0.22, 0.25],
-            // Curves stay readable when printed: about 1/180 of the picture's height, at least 3 px.
-            viewport: [
-                size.0 as f32,
-                size.1 as f32,
-                (size.1 as f32 / 180.0).max(3.0),
-                2e-4,
-            ],
-        }
-    }
-}
+use super::gpu::{Segment, SurfaceVertex};
+use super::{CurvatureKind, Curve, RenderError, Style};
 
 /// A surface ready to upload: unindexed triangle corners, and its bounding sphere.
 pub struct SceneGeometry {
@@ -88,7 +21,7 @@ pub struct SceneGeometry {
 /// The shaded style's colour.
 pub const SURFACE_COLOUR: [f32; 3] = [0.55, 0.68, 0.9];
 
-/// A fixed palette indexed by chart id. The renderer's charts style uses [`crate::palette`] (one
+/// A fixed palette indexed by chart id. The renderer's charts style uses [`crate::render::palette`] (one
 /// colour per chart kind and edge pair, as in the figures); this stays for callers that only know ids.
 pub const CHART_PALETTE: [[f32; 3]; 8] = [
     [0.89, 0.35, 0.32],
@@ -101,55 +34,44 @@ pub const CHART_PALETTE: [[f32; 3]; 8] = [
     [0.62, 0.62, 0.62],
 ];
 
-/// The model tessellated at t_e = t_r = `t`, coloured by `style`.
+/// The surface tessellated at t_e = t_r = `t`, coloured by `style`.
 pub fn model_geometry(
-    model: &Model,
+    surface: &Surface,
     t: u32,
     style: Style,
     curves: &[Curve],
 ) -> Result<SceneGeometry, RenderError> {
-    let atlas = Atlas::new(model.genus)?;
-    let layout = Layout::new(&atlas, model.settings)?;
-    model.validate(&layout)?;
+    let atlas = surface.atlas();
     let tess = atlas.tessellate(t, t)?;
-    let control = model.points();
-    let stencil = Stencil::build(&layout, &tess.vertices);
-    let mut positions = vec![Point3::zeros(); tess.vertices.len()];
-    let mut normals = positions.clone();
-    stencil.positions(&control, &mut positions);
-    stencil.normals(&control, &mut normals);
-    let (colours, legend) = match style {
-        Style::Shaded | Style::Wireframe => (vec![SURFACE_COLOUR; positions.len()], None),
-        Style::Charts => (
-            tess.vertices
-                .iter()
-                .map(|p| blend_colour(&atlas, &layout.blends(*p)))
-                .collect(),
-            None,
-        ),
-        Style::Curvature(kind) => {
-            let values: Vec<f64> = tess
-                .vertices
-                .iter()
-                .map(|p| {
-                    let s = layout.eval(&control, *p);
-                    match kind {
-                        CurvatureKind::Gaussian => s.gaussian_curvature(),
-                        CurvatureKind::Mean => s.mean_curvature(),
-                    }
-                })
-                .collect();
-            let range = robust_range(&values);
-            let colours = values.iter().map(|&v| diverging(v / range)).collect();
-            (colours, Some((kind, range)))
-        }
+    let wants = Wants {
+        curvature: matches!(style, Style::Curvature(_)),
+        blends: matches!(style, Style::Charts),
     };
-    let corners: Vec<([f64; 3], [f64; 3], [f32; 3])> = (0..positions.len())
-        .map(|i| {
-            let (p, n) = (positions[i], normals[i]);
-            ([p.x, p.y, p.z], [n.x, n.y, n.z], colours[i])
-        })
-        .collect();
+    let n = tess.vertices.len();
+    let (mut corners, mut values) = (Vec::with_capacity(n), Vec::new());
+    // No threshold: a pinched point gets a non-finite normal, as the GPU would compute it.
+    evaluate(surface, &tess.vertices, wants, 0.0, &mut |s: &Sample| {
+        let normal = s.du.cross(&s.dv).normalize();
+        let colour = match style {
+            Style::Charts => blend_colour(atlas, &s.blends),
+            _ => SURFACE_COLOUR,
+        };
+        if let (Style::Curvature(kind), Some(k)) = (style, s.curvature) {
+            values.push(match kind {
+                CurvatureKind::Gaussian => k.gaussian,
+                CurvatureKind::Mean => k.mean,
+            });
+        }
+        corners.push((s.position.into(), normal.into(), colour));
+    });
+    let mut legend = None;
+    if let Style::Curvature(kind) = style {
+        let range = robust_range(&values);
+        for (corner, &v) in corners.iter_mut().zip(&values) {
+            corner.2 = diverging(v / range);
+        }
+        legend = Some((kind, range));
+    }
     let mut geometry = unindexed(&corners, &tess.triangles);
     geometry.segments = segments(curves);
     geometry.legend = legend;
@@ -236,10 +158,10 @@ fn segments(curves: &[Curve]) -> Vec<Segment> {
 }
 
 /// Σ b̂_c · colour of chart c, in the figures' palette (one colour per chart kind and edge pair).
-fn blend_colour(atlas: &Atlas, blends: &[(charts::ChartId, f64)]) -> [f32; 3] {
+pub fn blend_colour(atlas: &Atlas, blends: &[(charts::ChartId, f64)]) -> [f32; 3] {
     let mut c = [0.0f32; 3];
     for &(chart, b) in blends {
-        let k = crate::palette::surface_rgb(atlas.charts()[chart.index()].kind());
+        let k = crate::render::palette::surface_rgb(atlas.charts()[chart.index()].kind());
         for ch in 0..3 {
             c[ch] += b as f32 * k[ch];
         }

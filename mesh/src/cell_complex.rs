@@ -9,8 +9,8 @@
 //! inconsistency) or from a [`HalfEdgeMesh`].
 //!
 //! ```
-//! use ntori::cell_complex::CellComplex;
-//! use ntori::mesh::HalfEdgeMesh;
+//! use mesh::cell_complex::CellComplex;
+//! use mesh::HalfEdgeMesh;
 //! let faces = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
 //! let mesh = HalfEdgeMesh::from_polygons(4, faces.iter().map(|f| &f[..])).unwrap();
 //! let complex = CellComplex::from_mesh(&mesh);
@@ -25,7 +25,7 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
-use crate::mesh::HalfEdgeMesh;
+use crate::halfedge::HalfEdgeMesh;
 
 /// One cell: the cells of one dimension lower on its boundary, and those one higher it bounds.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

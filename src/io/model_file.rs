@@ -2,15 +2,15 @@
 //! written atomically.
 //!
 //! [`load`] reads the header (`format`, `version`) before the rest, so a file from a newer ntori is
-//! refused as such rather than as malformed, then checks the model against the layout its genus and
-//! settings define ([`embedding::Model::validate`]). Every error names the file.
+//! refused as such rather than as malformed, then builds the [`Surface`] (which checks the model
+//! against the layout its genus and settings define). Every error names the file.
 
 use std::path::{Path, PathBuf};
 
-use embedding::{EmbeddingError, Layout, Model, ModelHeader};
+use embedding::{EmbeddingError, Model, ModelHeader, Surface};
 use serde::Deserialize as _;
 
-use crate::files::{FileError, write_atomically};
+use crate::io::atomic::{FileError, write_atomically};
 
 /// Why a model file could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -52,8 +52,8 @@ pub enum ModelFileError {
     Write(#[from] FileError),
 }
 
-/// Reads and checks a model file.
-pub fn load(path: impl AsRef<Path>) -> Result<Model, ModelFileError> {
+/// Reads and checks a model file: the surface it holds, validated once and for all.
+pub fn load(path: impl AsRef<Path>) -> Result<Surface, ModelFileError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|source| match source.kind() {
         std::io::ErrorKind::NotFound => ModelFileError::Missing {
@@ -94,20 +94,18 @@ pub fn load(path: impl AsRef<Path>) -> Result<Model, ModelFileError> {
         other => not_a_model(other.to_string()),
     })?;
     let model = Model::deserialize(value).map_err(|e| not_a_model(e.to_string()))?;
-    let inconsistent = |source: EmbeddingError| ModelFileError::Inconsistent {
+    Surface::from_model(&model).map_err(|source| ModelFileError::Inconsistent {
         path: path.to_owned(),
         source,
-    };
-    let atlas = charts::Atlas::new(model.genus).map_err(|e| inconsistent(e.into()))?;
-    let layout = Layout::new(&atlas, model.settings).map_err(inconsistent)?;
-    model.validate(&layout).map_err(inconsistent)?;
-    Ok(model)
+    })
 }
 
-/// Writes a model file atomically (a file that exists is replaced; callers decide whether it may).
-pub fn save(path: impl AsRef<Path>, model: &Model) -> Result<(), ModelFileError> {
+/// Writes a surface's model file atomically (a file that exists is replaced; callers decide whether
+/// it may).
+pub fn save(path: impl AsRef<Path>, surface: &Surface) -> Result<(), ModelFileError> {
     let path = path.as_ref();
-    let mut text = serde_json::to_string(model).map_err(|source| ModelFileError::Serialize {
+    let model = surface.to_model();
+    let mut text = serde_json::to_string(&model).map_err(|source| ModelFileError::Serialize {
         path: path.to_owned(),
         source,
     })?;

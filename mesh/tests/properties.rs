@@ -1,7 +1,7 @@
 //! Property tests of the half-edge mesh: no input makes it panic, and topology does not depend on how
 //! vertices are numbered or where each face's cycle starts.
 
-use ntori::mesh::HalfEdgeMesh;
+use mesh::HalfEdgeMesh;
 use proptest::prelude::*;
 
 proptest! {

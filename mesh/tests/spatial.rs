@@ -1,11 +1,11 @@
-//! Tests of `ntori::spatial`: self-intersections by what triangles share (hand-made pairs, closed
+//! Tests of `mesh::spatial`: self-intersections by what triangles share (hand-made pairs, closed
 //! meshes, meshes broken on purpose, and property tests against an independent separating-axis test),
 //! degenerate triangles, input errors, and the sampled Hausdorff distance against a brute-force
 //! reference.
 
 use std::collections::HashMap;
 
-use ntori::spatial::{
+use mesh::spatial::{
     MeshRef, SpatialError, bounding_box_diagonal, closest_point_on_triangle, degenerate_triangles,
     hausdorff, self_intersections,
 };

@@ -7,7 +7,7 @@
 //! error.
 //!
 //! ```
-//! use ntori::mesh::HalfEdgeMesh;
+//! use mesh::HalfEdgeMesh;
 //! // A tetrahedron: closed, orientable, genus 0.
 //! let faces = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
 //! let mesh = HalfEdgeMesh::from_polygons(4, faces.iter().map(|f| &f[..])).unwrap();

@@ -2,12 +2,52 @@
 //! same run (this machine is shared and noisy; ratios travel better than seconds).
 
 use std::hint::black_box;
+use std::process::ExitCode;
 use std::time::Instant;
 
 use charts::{Atlas, ChartPoint};
 use embedding::edit::{Constraint, RefreshScratch, refresh, solve};
 use embedding::{Layout, Point3, SplineSettings, Stencil};
 use serde::Serialize;
+
+use super::{GenusArg, spinner, write_stdout};
+
+/// Measure throughput and print it as JSON.
+///
+/// Figures for tessellation, point location, stencil building, re-embedding (also as a fraction
+/// of memory copy bandwidth) and drag events. Baselines (copy bandwidth, a chain of scalar
+/// multiply-adds) are measured in the same run, and every figure is also given per baseline
+/// operation, since this machine is shared and noisy.
+///
+/// For statistics and history use `cargo bench`; this is the quick look.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    genus: GenusArg,
+    /// About how many vertices to measure with.
+    #[arg(long, default_value_t = 100_000, value_name = "V",
+          value_parser = clap::value_parser!(u64).range(10..=5_000_000))]
+    vertices: u64,
+    /// No progress messages on stderr.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let Args {
+        genus: GenusArg { genus },
+        vertices,
+        quiet,
+    } = args;
+    let bar = spinner(quiet);
+    let report = measure(genus, vertices as usize, &|stage| {
+        bar.set_message(format!("measuring {stage}"));
+        bar.tick();
+    })?;
+    bar.finish_and_clear();
+    write_stdout(&(serde_json::to_string_pretty(&report)? + "\n"))?;
+    Ok(ExitCode::SUCCESS)
+}
 
 /// One measured figure.
 #[derive(Debug, Serialize)]
@@ -69,11 +109,11 @@ fn scalar_ops() -> f64 {
 
 /// Measures chart location, tessellation, stencil building, re-embedding and a drag event for genus
 /// `genus` at about `vertices` vertices.
-pub fn run(
+pub fn measure(
     genus: u32,
     vertices: usize,
     progress: &dyn Fn(&str),
-) -> Result<BenchReport, anyhow::Error> {
+) -> anyhow::Result<BenchReport> {
     progress("baselines");
     let (bandwidth, scalar) = (copy_bandwidth(), scalar_ops());
     let atlas = Atlas::new(genus)?;

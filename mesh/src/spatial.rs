@@ -326,7 +326,7 @@ impl RTreeObject for BoxEntry {
 /// have zero signed area. Includes triangles that repeat a vertex index or a position.
 ///
 /// ```
-/// use ntori::spatial::degenerate_triangles;
+/// use mesh::spatial::degenerate_triangles;
 /// let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [2.0, 0.0, 0.0]];
 /// let triangles = [[0, 1, 2], [0, 1, 3], [2, 2, 1]];
 /// assert_eq!(degenerate_triangles(&positions, &triangles).unwrap(), vec![1, 2]);
@@ -356,7 +356,7 @@ pub fn degenerate_triangles(
 /// out here; a clean mesh has neither.
 ///
 /// ```
-/// use ntori::spatial::self_intersections;
+/// use mesh::spatial::self_intersections;
 /// // Two triangles, the second piercing the first through its middle.
 /// let positions = [
 ///     [0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0],
@@ -460,7 +460,7 @@ fn closest_point_on_segment(p: &Point, a: &Point, b: &Point) -> Point {
 /// edges is the answer, since such a triangle is the union of its edges.
 ///
 /// ```
-/// use ntori::spatial::closest_point_on_triangle;
+/// use mesh::spatial::closest_point_on_triangle;
 /// let t = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
 /// assert_eq!(closest_point_on_triangle([0.5, 0.5, 3.0], t), [0.5, 0.5, 0.0]);
 /// assert_eq!(closest_point_on_triangle([-1.0, -1.0, 0.0], t), [0.0, 0.0, 0.0]);
@@ -740,7 +740,7 @@ fn one_sided(from: MeshRef, to: MeshRef) -> f64 {
 /// the true Hausdorff distance, tight to within the meshes' deviation from flat between the samples.
 ///
 /// ```
-/// use ntori::spatial::{MeshRef, hausdorff};
+/// use mesh::spatial::{MeshRef, hausdorff};
 /// let square = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
 /// let lifted = square.map(|[x, y, z]| [x, y, z + 0.25]);
 /// let triangles = [[0, 1, 2], [0, 2, 3]];
@@ -770,7 +770,7 @@ pub fn hausdorff(a: MeshRef, b: MeshRef) -> Result<Hausdorff, SpatialError> {
 /// state distance tolerances against. Every position counts, used by a triangle or not.
 ///
 /// ```
-/// use ntori::spatial::bounding_box_diagonal;
+/// use mesh::spatial::bounding_box_diagonal;
 /// let d = bounding_box_diagonal(&[[0.0, 0.0, 0.0], [1.0, 2.0, 2.0], [0.5, 0.5, 0.5]]).unwrap();
 /// assert_eq!(d, 3.0);
 /// ```

@@ -1,0 +1,197 @@
+//! [`Surface`]: an owned, validated surface — the atlas, the spline settings and every control
+//! point — built once (by loading a model or by a fit) and never checked again by its users.
+//!
+//! A [`Model`] is the serde document a file holds; a `Surface` is what the program works with. The
+//! conversion checks everything a file can get wrong (format, version, genus, settings, the number
+//! of control points, finiteness); after it, [`Surface::layout`] cannot fail, and every consumer —
+//! export, the renderer, the editor — evaluates through [`crate::evaluate`].
+
+use std::sync::Arc;
+
+use charts::{Atlas, ChartPoint};
+
+use crate::EmbeddingError;
+use crate::bspline::UniformBasis;
+use crate::model::{Model, ModelHeader};
+use crate::surface::{Layout, Point3, SplineSettings, SurfaceJet};
+
+/// A control point's index in [`Layout`] order (chart-major, then row-major in the chart's grid).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
+pub struct ControlId(pub u32);
+
+impl ControlId {
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// An owned, validated surface (see the module documentation). Two surfaces are equal when their
+/// genus, settings and control points are.
+#[derive(Clone, Debug)]
+pub struct Surface {
+    atlas: Arc<Atlas>,
+    settings: SplineSettings,
+    basis: UniformBasis,
+    control: Vec<Point3>,
+}
+
+impl PartialEq for Surface {
+    fn eq(&self, other: &Surface) -> bool {
+        self.genus() == other.genus()
+            && self.settings == other.settings
+            && self.control == other.control
+    }
+}
+
+impl Surface {
+    /// A surface over `atlas` with `settings` and `control` points in layout order. Refuses
+    /// unsupported settings, the wrong number of points and non-finite coordinates.
+    pub fn new(
+        atlas: Arc<Atlas>,
+        settings: SplineSettings,
+        control: Vec<Point3>,
+    ) -> Result<Surface, EmbeddingError> {
+        let basis = Layout::new(&atlas, settings)?.basis();
+        let surface = Surface {
+            atlas,
+            settings,
+            basis,
+            control: Vec::new(),
+        };
+        surface.check_points(&control)?;
+        Ok(Surface { control, ..surface })
+    }
+
+    /// The surface a model document describes, with every check a file needs (header, genus,
+    /// settings, control point count, finiteness).
+    pub fn from_model(model: &Model) -> Result<Surface, EmbeddingError> {
+        Surface::from_model_with_atlas(model, None)
+    }
+
+    /// Like [`Surface::from_model`], reusing `atlas` when it has the model's genus (an atlas of
+    /// genus 64 takes a tenth of a second to build).
+    pub fn from_model_with_atlas(
+        model: &Model,
+        atlas: Option<Arc<Atlas>>,
+    ) -> Result<Surface, EmbeddingError> {
+        ModelHeader {
+            format: model.format.clone(),
+            version: model.version,
+        }
+        .check()?;
+        let atlas = match atlas {
+            Some(a) if a.genus() == model.genus => a,
+            _ => Arc::new(Atlas::new(model.genus)?),
+        };
+        let layout = Layout::new(&atlas, model.settings)?;
+        model.validate(&layout)?;
+        let control = model.points();
+        Surface::new(atlas, model.settings, control)
+    }
+
+    /// The model document of this surface (current format and version).
+    pub fn to_model(&self) -> Model {
+        Model::from_points(&self.layout(), &self.control)
+    }
+
+    /// The same atlas and settings with other control points (checked like [`Surface::new`]).
+    pub fn with_control_points(&self, control: Vec<Point3>) -> Result<Surface, EmbeddingError> {
+        self.check_points(&control)?;
+        Ok(Surface {
+            control,
+            ..self.clone_empty()
+        })
+    }
+
+    /// Replaces the control points (checked like [`Surface::new`]; on error nothing changes).
+    pub fn set_control_points(&mut self, control: Vec<Point3>) -> Result<(), EmbeddingError> {
+        self.check_points(&control)?;
+        self.control = control;
+        Ok(())
+    }
+
+    /// Sets some control points to new positions (checked: on error nothing changes).
+    pub fn set_control_points_at(
+        &mut self,
+        updates: impl IntoIterator<Item = (ControlId, Point3)> + Clone,
+    ) -> Result<(), EmbeddingError> {
+        for (id, p) in updates.clone() {
+            if id.index() >= self.control.len() {
+                return Err(EmbeddingError::ControlCount {
+                    found: id.index() + 1,
+                    expected: self.control.len(),
+                });
+            }
+            if !p.iter().all(|x| x.is_finite()) {
+                return Err(EmbeddingError::NotFinite(id.index()));
+            }
+        }
+        for (id, p) in updates {
+            self.control[id.index()] = p;
+        }
+        Ok(())
+    }
+
+    pub fn genus(&self) -> u32 {
+        self.atlas.genus()
+    }
+    pub fn atlas(&self) -> &Atlas {
+        &self.atlas
+    }
+    /// The shared atlas, for another surface of the same genus.
+    pub fn shared_atlas(&self) -> Arc<Atlas> {
+        Arc::clone(&self.atlas)
+    }
+    pub fn settings(&self) -> SplineSettings {
+        self.settings
+    }
+    /// The control points in layout order.
+    pub fn control_points(&self) -> &[Point3] {
+        &self.control
+    }
+
+    /// The layout of the control points over the atlas. Cannot fail: the settings were checked.
+    pub fn layout(&self) -> Layout<'_> {
+        Layout::from_checked(&self.atlas, self.basis, self.settings)
+    }
+
+    /// S and its first and second derivatives at `p`, in `p.chart`'s coordinates.
+    pub fn eval(&self, p: ChartPoint) -> SurfaceJet {
+        self.layout().eval(&self.control, p)
+    }
+
+    /// The diagonal of the control points' bounding box: the scale derivatives in chart units have.
+    pub fn control_net_size(&self) -> f64 {
+        let (lo, hi) = self.control.iter().fold(
+            (
+                Point3::repeat(f64::INFINITY),
+                Point3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        (hi - lo).norm()
+    }
+
+    fn check_points(&self, control: &[Point3]) -> Result<(), EmbeddingError> {
+        let expected = self.atlas.charts().len() * self.settings.grid * self.settings.grid;
+        if control.len() != expected {
+            return Err(EmbeddingError::ControlCount {
+                found: control.len(),
+                expected,
+            });
+        }
+        match control.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+            Some(i) => Err(EmbeddingError::NotFinite(i)),
+            None => Ok(()),
+        }
+    }
+
+    fn clone_empty(&self) -> Surface {
+        Surface {
+            atlas: Arc::clone(&self.atlas),
+            settings: self.settings,
+            basis: self.basis,
+            control: Vec::new(),
+        }
+    }
+}

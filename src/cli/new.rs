@@ -1,0 +1,246 @@
+//! `ntori new`: the initial model of a genus, fitted to an n-holed mesh, with its checks.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use embedding::fit::{FitSettings, InitialFit, initial_model};
+use embedding::integrals::surface_integrals;
+use embedding::{SplineSettings, Surface};
+use serde::Serialize;
+
+use super::report::{Report, emit};
+use super::{GenusArg, spinner};
+
+/// Make a new model: a smooth genus-n surface fitted to an n-holed mesh, written as a model file.
+///
+/// The paper's section 5.1. A genus-n mesh (a round plate with n holes, rims rounded; the sphere for
+/// n = 0, the round torus for n = 1) is cut along 2n loops through one vertex into a disk whose
+/// boundary reads a₁ b₁ a₁⁻¹ b₁⁻¹ …; Floater's mean value map flattens the disk onto the polygon
+/// (in the Klein model, where it is convex), the map is relaxed on the closed surface so it has no
+/// seams, and every chart's control points are fitted at once by regularised least squares.
+///
+/// Prints the fit's checks: folded triangles in the parameterization (0: a bijection), the
+/// residual |S(p_i) − P_i| at the mesh vertices as a fraction of the mesh's size, and Gauss–Bonnet
+/// (∫K dA from the analytic curvature against 2π(2 − 2n)). Exit status 3 if a check fails. An
+/// existing file is not replaced unless --force is given.
+///
+/// Examples:
+///   ntori new                                 genus 2, written to model.json
+///   ntori new --genus 5 -o five.json --grid 16
+#[derive(clap::Args, Debug)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    #[command(flatten)]
+    genus: GenusArg,
+    /// Where to write the model.
+    #[arg(short, long, default_value = "model.json", value_name = "FILE")]
+    output: PathBuf,
+    /// Replace the output file if it exists.
+    #[arg(long)]
+    force: bool,
+    /// Input mesh resolution: points around each hole (around the equator for the sphere).
+    #[arg(long, default_value_t = 32, value_name = "R",
+          value_parser = clap::value_parser!(u64).range(8..=1024))]
+    resolution: u64,
+    /// Control points per side of each chart's grid.
+    #[arg(long, default_value_t = SplineSettings::default().grid as u64, value_name = "G",
+          value_parser = clap::value_parser!(u64).range(4..=64))]
+    grid: u64,
+    /// Spline degree.
+    #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
+          value_parser = clap::value_parser!(u64).range(1..=7))]
+    degree: u64,
+    /// Continuity order of the blend functions (1 to 4).
+    #[arg(long, default_value_t = SplineSettings::default().continuity as u64, value_name = "K",
+          value_parser = clap::value_parser!(u64).range(1..=4))]
+    continuity: u64,
+    /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term).
+    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ")]
+    smoothness: f64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+    /// No progress messages on stderr.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let Args {
+        genus: GenusArg { genus },
+        output,
+        force,
+        resolution,
+        grid,
+        degree,
+        continuity,
+        smoothness,
+        json,
+        quiet,
+    } = args;
+    if output.exists() && !force {
+        anyhow::bail!(
+            "{} exists; pass --force to replace it, or -o to write elsewhere",
+            output.display()
+        );
+    }
+    let settings = SplineSettings {
+        degree: degree as usize,
+        continuity: continuity as usize,
+        grid: grid as usize,
+    };
+    let fit = FitSettings {
+        smoothness,
+        ..FitSettings::default()
+    };
+    let bar = spinner(quiet);
+    let made = make(genus, resolution as usize, settings, fit, &|stage| {
+        bar.set_message(stage.to_string());
+        bar.tick();
+    });
+    bar.finish_and_clear();
+    let (model, report) = made.with_context(|| format!("cannot make a genus-{genus} model"))?;
+    ntori::io::model_file::save(&output, &model)?;
+    emit(
+        &Written {
+            report: &report,
+            output: &output,
+        },
+        json,
+    )
+}
+
+/// The report once the model is saved: as text it also says where the model went; as JSON it is
+/// the report alone.
+#[derive(Serialize)]
+#[serde(transparent)]
+struct Written<'a> {
+    report: &'a NewReport,
+    #[serde(skip)]
+    output: &'a Path,
+}
+
+impl Report for Written<'_> {
+    fn passed(&self) -> bool {
+        self.report.passed
+    }
+
+    fn to_text(&self) -> String {
+        self.report.to_text() + &format!("wrote {}\n", self.output.display())
+    }
+}
+
+/// What `ntori new` made and how well it fits.
+#[derive(Clone, Debug, Serialize)]
+pub struct NewReport {
+    pub genus: u32,
+    pub settings: SplineSettings,
+    pub smoothness: f64,
+    pub mesh_vertices: usize,
+    pub mesh_triangles: usize,
+    pub control_points: usize,
+    /// Relaxation sweeps of the parameterization, and triangles it folds (0: a bijection).
+    pub sweeps: usize,
+    pub folded_triangles: usize,
+    /// |S(p_i) − P_i| over the mesh vertices, as fractions of the mesh's bounding-box diagonal.
+    pub rms_residual: f64,
+    pub max_residual: f64,
+    pub diagonal: f64,
+    /// ∫ K dA from the analytic curvature, and 2π(2 − 2n).
+    pub total_curvature: f64,
+    pub expected_curvature: f64,
+    /// |∫K dA − 2π(2 − 2n)| / max(|2π(2 − 2n)|, ∫|K| dA).
+    pub curvature_error: f64,
+    pub area: f64,
+    pub seconds: f64,
+    pub passed: bool,
+}
+
+/// Largest relative Gauss–Bonnet error the check accepts (relative to ∫|K| dA for the torus).
+pub const CURVATURE_TOLERANCE: f64 = 1e-3;
+/// Largest residual, as a fraction of the diagonal, the check accepts.
+pub const RESIDUAL_TOLERANCE: f64 = 0.01;
+
+/// Fits the model and checks it. `stage` is told what is being done.
+pub fn make(
+    genus: u32,
+    resolution: usize,
+    settings: SplineSettings,
+    fit: FitSettings,
+    stage: &dyn Fn(&str),
+) -> Result<(Surface, NewReport), embedding::EmbeddingError> {
+    let start = std::time::Instant::now();
+    stage("meshing, flattening and fitting");
+    let InitialFit {
+        surface,
+        mesh,
+        parameterization,
+        rms_residual,
+        max_residual,
+        mesh_diagonal,
+    } = initial_model(genus, resolution, settings, fit)?;
+    stage("integrating the curvature");
+    let sums = surface_integrals(&surface.layout(), surface.control_points(), 8);
+    let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
+    let curvature_error =
+        (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
+    let report = NewReport {
+        genus,
+        settings,
+        smoothness: fit.smoothness,
+        mesh_vertices: mesh.positions.len(),
+        mesh_triangles: mesh.triangles.len(),
+        control_points: surface.control_points().len(),
+        sweeps: parameterization.sweeps,
+        folded_triangles: parameterization.folded,
+        rms_residual: rms_residual / mesh_diagonal,
+        max_residual: max_residual / mesh_diagonal,
+        diagonal: mesh_diagonal,
+        total_curvature: sums.gaussian_curvature,
+        expected_curvature: expected,
+        curvature_error,
+        area: sums.area,
+        seconds: start.elapsed().as_secs_f64(),
+        passed: parameterization.folded == 0
+            && curvature_error <= CURVATURE_TOLERANCE
+            && max_residual <= RESIDUAL_TOLERANCE * mesh_diagonal,
+    };
+    Ok((surface, report))
+}
+
+impl NewReport {
+    /// The human-readable form (without the line saying where the model went).
+    fn to_text(&self) -> String {
+        let verdict = |ok: bool| if ok { "ok" } else { "FAILED" };
+        format!(
+            "genus {genus}: degree {degree}, C^{cont} blends, {grid}×{grid} control grid per chart, \
+             {controls} control points\n\
+             input mesh: {v} vertices, {f} triangles, bounding-box diagonal {diag:.3}\n\
+             parameterization: {sweeps} relaxation sweeps, {folded} folded triangles ({bij})\n\
+             fit residual: rms {rms:.3}%, max {max:.3}% of the diagonal ({res})\n\
+             Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, relative error {gb:.1e} ({gbv})\n\
+             area {area:.4}, {secs:.2} s\n",
+            genus = self.genus,
+            degree = self.settings.degree,
+            cont = self.settings.continuity,
+            grid = self.settings.grid,
+            controls = self.control_points,
+            v = self.mesh_vertices,
+            f = self.mesh_triangles,
+            diag = self.diagonal,
+            sweeps = self.sweeps,
+            folded = self.folded_triangles,
+            bij = verdict(self.folded_triangles == 0),
+            rms = 100.0 * self.rms_residual,
+            max = 100.0 * self.max_residual,
+            res = verdict(self.max_residual <= RESIDUAL_TOLERANCE),
+            k = self.total_curvature,
+            e = self.expected_curvature,
+            gb = self.curvature_error,
+            gbv = verdict(self.curvature_error <= CURVATURE_TOLERANCE),
+            area = self.area,
+            secs = self.seconds,
+        )
+    }
+}

@@ -1,0 +1,33 @@
+//! Wavefront OBJ.
+
+use std::io::Write;
+
+use super::SurfaceMesh;
+
+/// Wavefront OBJ: `v`, `vt`, `vn` per vertex (same index), faces `f a/a/a b/b/b c/c/c`. OBJ has no
+/// per-vertex attribute that could carry the chart id.
+pub fn write_obj(mesh: &SurfaceMesh, out: &mut dyn Write) -> std::io::Result<()> {
+    writeln!(out, "# {}", mesh.describe())?;
+    writeln!(
+        out,
+        "# vt: the vertex's home chart coordinates + 0.5; vn: the analytic unit normal, outward"
+    )?;
+    writeln!(out, "o ntori_genus_{}", mesh.genus)?;
+    for i in 0..mesh.positions.len() {
+        let [x, y, z] = mesh.position_f32(i);
+        writeln!(out, "v {x} {y} {z}")?;
+    }
+    for uv in &mesh.uvs {
+        let [u, v] = uv.map(|x| x as f32);
+        writeln!(out, "vt {u} {v}")?;
+    }
+    for i in 0..mesh.normals.len() {
+        let [x, y, z] = mesh.normal_f32(i);
+        writeln!(out, "vn {x} {y} {z}")?;
+    }
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| i + 1);
+        writeln!(out, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
+    }
+    Ok(())
+}

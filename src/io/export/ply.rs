@@ -1,0 +1,119 @@
+//! Stanford PLY, binary little endian or ASCII.
+
+use std::io::Write;
+
+use super::{Encoding, SurfaceMesh};
+
+mod records {
+    //! PLY records for ply-rs-bw's writer (its element type is a trait, so no hash maps).
+    use ply_rs_bw::ply::PropertyAccess;
+
+    #[derive(Clone, Copy, Debug, Default)]
+    pub struct Vertex {
+        pub position: [f32; 3],
+        pub normal: [f32; 3],
+        pub uv: [f32; 2],
+        pub chart: u32,
+    }
+
+    impl PropertyAccess for Vertex {
+        fn new() -> Self {
+            Vertex::default()
+        }
+        fn get_float(&self, name: &str) -> Option<f32> {
+            Some(match name {
+                "x" => self.position[0],
+                "y" => self.position[1],
+                "z" => self.position[2],
+                "nx" => self.normal[0],
+                "ny" => self.normal[1],
+                "nz" => self.normal[2],
+                "u" => self.uv[0],
+                "v" => self.uv[1],
+                _ => return None,
+            })
+        }
+        fn get_uint(&self, name: &str) -> Option<u32> {
+            (name == "chart").then_some(self.chart)
+        }
+    }
+
+    #[derive(Clone, Copy, Debug, Default)]
+    pub struct Face(pub [i32; 3]);
+
+    impl PropertyAccess for Face {
+        fn new() -> Self {
+            Face::default()
+        }
+        fn get_list_int(&self, name: &str) -> Option<&[i32]> {
+            (name == "vertex_indices").then_some(&self.0[..])
+        }
+    }
+}
+
+/// Stanford PLY, binary little endian or ASCII: vertex `x y z nx ny nz u v` (float) and `chart`
+/// (uint); face `vertex_indices` (list uchar int).
+pub fn write_ply(
+    mesh: &SurfaceMesh,
+    encoding: Encoding,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
+    use ply_rs_bw::ply::{
+        Addable, ElementDef, Encoding as PlyEncoding, Header, PropertyDef, PropertyType, ScalarType,
+    };
+    use ply_rs_bw::writer::Writer;
+
+    let mut header = Header::new();
+    header.encoding = match encoding {
+        Encoding::Ascii => PlyEncoding::Ascii,
+        Encoding::Binary => PlyEncoding::BinaryLittleEndian,
+    };
+    header.comments.push(mesh.describe());
+    header
+        .comments
+        .push("u v: the vertex's home chart coordinates + 0.5; chart: its home chart".into());
+    header
+        .comments
+        .push("nx ny nz: the analytic unit normal, outward".into());
+    let mut vertex = ElementDef::new("vertex".into());
+    vertex.count = mesh.positions.len();
+    for name in ["x", "y", "z", "nx", "ny", "nz", "u", "v"] {
+        vertex.properties.add(PropertyDef::new(
+            name.into(),
+            PropertyType::Scalar(ScalarType::Float),
+        ));
+    }
+    vertex.properties.add(PropertyDef::new(
+        "chart".into(),
+        PropertyType::Scalar(ScalarType::UInt),
+    ));
+    let mut face = ElementDef::new("face".into());
+    face.count = mesh.triangles.len();
+    face.properties.add(PropertyDef::new(
+        "vertex_indices".into(),
+        PropertyType::List(ScalarType::UChar, ScalarType::Int),
+    ));
+    header.elements.add(vertex.clone());
+    header.elements.add(face.clone());
+
+    let mut out = out;
+    let vertices: Vec<records::Vertex> = (0..mesh.positions.len())
+        .map(|i| records::Vertex {
+            position: mesh.position_f32(i),
+            normal: mesh.normal_f32(i),
+            uv: mesh.uvs[i].map(|x| x as f32),
+            chart: mesh.charts[i],
+        })
+        .collect();
+    let vertex_writer = Writer::<records::Vertex>::new();
+    vertex_writer.write_header(&mut out, &header)?;
+    vertex_writer.write_payload_of_element(&mut out, &vertices, &vertex, &header)?;
+    drop(vertices);
+    let faces: Vec<records::Face> = mesh
+        .triangles
+        .iter()
+        .map(|t| records::Face(t.map(|i| i as i32)))
+        .collect();
+    Writer::<records::Face>::new().write_payload_of_element(&mut out, &faces, &face, &header)?;
+    Ok(())
+}

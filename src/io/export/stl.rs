@@ -1,0 +1,51 @@
+//! STL, binary or ASCII.
+
+use std::io::Write;
+
+use super::{Encoding, SurfaceMesh};
+
+/// STL: one facet per triangle with its (outward) face normal; no shared vertices, no attributes.
+pub fn write_stl(
+    mesh: &SurfaceMesh,
+    encoding: Encoding,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
+    match encoding {
+        Encoding::Ascii => {
+            writeln!(out, "solid ntori")?;
+            for (k, t) in mesh.triangles.iter().enumerate() {
+                let [nx, ny, nz] = mesh.face_normal(k).map(|x| x as f32);
+                writeln!(out, "  facet normal {nx:e} {ny:e} {nz:e}")?;
+                writeln!(out, "    outer loop")?;
+                for &v in t {
+                    let [x, y, z] = mesh.position_f32(v as usize);
+                    writeln!(out, "      vertex {x:e} {y:e} {z:e}")?;
+                }
+                writeln!(out, "    endloop")?;
+                writeln!(out, "  endfacet")?;
+            }
+            writeln!(out, "endsolid ntori")
+        }
+        Encoding::Binary => {
+            // An 80-byte header that must not begin with "solid" (readers would take it for text).
+            let mut header = [b' '; 80];
+            let text = mesh.describe();
+            let n = text.len().min(80);
+            header[..n].copy_from_slice(&text.as_bytes()[..n]);
+            out.write_all(&header)?;
+            out.write_all(&(mesh.triangles.len() as u32).to_le_bytes())?;
+            let mut record = [0u8; 50];
+            for (k, t) in mesh.triangles.iter().enumerate() {
+                let normal = mesh.face_normal(k).map(|x| x as f32);
+                let corners = t.map(|v| mesh.position_f32(v as usize));
+                let values = std::iter::once(normal).chain(corners).flatten();
+                for (slot, x) in record.chunks_exact_mut(4).zip(values) {
+                    slot.copy_from_slice(&x.to_le_bytes());
+                }
+                // Bytes 48..50: the attribute byte count, zero.
+                out.write_all(&record)?;
+            }
+            Ok(())
+        }
+    }
+}
