@@ -16,7 +16,7 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Model, Point3, SplineSettings};
+use embedding::{Point3, SplineSettings, Surface};
 use ntori::editor::EditorState;
 use ntori::editor::state::Grab;
 use ntori::render::Style;
@@ -24,16 +24,16 @@ use ntori::render::Style;
 /// t_e = t_r = t for about 10^5 and 10^6 vertices at genus 2 (V ≈ 20 t²).
 const SIZES: [(usize, u32); 2] = [(100_000, 71), (1_000_000, 224)];
 
-fn model() -> Model {
+fn model() -> Surface {
     initial_model(2, 32, SplineSettings::default(), FitSettings::default())
         .expect("the default model fits")
-        .model
+        .surface
 }
 
 /// A state at t, with two pins and the point to drag: three tessellation vertices spread over the
 /// surface.
-fn setup(model: &Model, t: u32) -> (EditorState, charts::ChartPoint) {
-    let mut state = EditorState::new(model, t, t).expect("the model opens");
+fn setup(model: &Surface, t: u32) -> (EditorState, charts::ChartPoint) {
+    let mut state = EditorState::new(model.clone(), t, t).expect("the model opens");
     let n = state.mesh().vertex_count();
     let vertices = &state.mesh().tessellation.vertices;
     let (dragged, pins) = (vertices[n / 3], [vertices[n / 7], vertices[n / 2]]);

@@ -1,17 +1,7 @@
 // Polylines on the surface, drawn on top as screen-space ribbons of constant pixel width: each
 // segment is one instance, expanded to two triangles in clip space, pulled slightly towards the
-// camera so the surface it lies on does not hide it.
-
-struct Frame {
-    view_proj: mat4x4<f32>,
-    eye: vec4<f32>,
-    light: vec4<f32>,
-    params: vec4<f32>,
-    // x, y: viewport size in pixels; z: line width in pixels; w: depth pull (clip-space w units).
-    viewport: vec4<f32>,
-};
-
-@group(0) @binding(0) var<uniform> frame: Frame;
+// camera so the surface it lies on does not hide it. The uniforms (`frame`) are frame.wgsl's, put in
+// front of this file.
 
 struct SegmentIn {
     @location(0) a: vec3<f32>,

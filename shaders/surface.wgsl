@@ -1,19 +1,7 @@
 // The surface: per-vertex colour (flat, chart blend or curvature), analytic normals, two-sided
 // Blinn–Phong lighting from a key light fixed relative to the camera, and an optional wireframe
-// drawn from barycentric coordinates (constant width in pixels, antialiased by fwidth).
-
-struct Frame {
-    view_proj: mat4x4<f32>,
-    eye: vec4<f32>,
-    // Key light direction (towards the light), world space.
-    light: vec4<f32>,
-    // x: wireframe on (1) or off (0); y: line width in pixels; z: ambient; w: specular strength.
-    params: vec4<f32>,
-    // Used by the curves (see curves.wgsl); the same uniform buffer serves both pipelines.
-    viewport: vec4<f32>,
-};
-
-@group(0) @binding(0) var<uniform> frame: Frame;
+// drawn from barycentric coordinates (constant width in pixels, antialiased by fwidth). The uniforms
+// (`frame`) are frame.wgsl's, put in front of this file.
 
 struct VertexIn {
     @location(0) position: vec3<f32>,

@@ -11,7 +11,7 @@ use egui::{Event, Key, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Model, Point3, SplineSettings};
+use embedding::{Point3, SplineSettings, Surface};
 use ntori::editor::camera::Ray;
 use ntori::editor::pick::cast_all;
 use ntori::editor::recovery::{RECOVERY_FORMAT, Recovery, RecoveryFile};
@@ -19,12 +19,12 @@ use ntori::editor::state::Grab;
 use ntori::editor::{EditorApp, EditorOptions, EditorState};
 
 /// The default genus-2 model, fitted once for all tests.
-fn model() -> &'static Model {
-    static MODEL: OnceLock<Model> = OnceLock::new();
+fn model() -> &'static Surface {
+    static MODEL: OnceLock<Surface> = OnceLock::new();
     MODEL.get_or_init(|| {
         initial_model(2, 32, SplineSettings::default(), FitSettings::default())
             .expect("the default model fits")
-            .model
+            .surface
     })
 }
 
@@ -381,17 +381,20 @@ fn save_then_open_round_trips_exactly() {
     }
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("edited.json");
-    let saved = harness.state().state().unwrap().model();
+    let saved = harness.state().state().unwrap().surface().to_model();
     harness.state_mut().save_to(&path).unwrap();
     assert!(!harness.state().state().unwrap().is_modified());
     harness.state_mut().open(&path).unwrap();
     harness.run();
     let state = harness.state().state().unwrap();
-    let opened = state.model();
+    let opened = state.surface().to_model();
     assert_eq!(opened, saved, "bit for bit");
     assert_eq!(state.path(), Some(path.as_path()));
     assert!(!state.is_modified());
-    assert_eq!(ntori::io::model_file::load(&path).unwrap(), saved);
+    assert_eq!(
+        ntori::io::model_file::load(&path).unwrap().to_model(),
+        saved
+    );
 }
 
 #[test]
@@ -474,7 +477,7 @@ fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
         pid: u32::MAX - 7,
         saved_at: 0,
         original: Some(PathBuf::from("/somewhere/sculpture.json")),
-        model: model().clone(),
+        model: model().to_model(),
     };
     std::fs::write(
         dir.path().join("recovery-4294967288.json"),
@@ -501,7 +504,7 @@ fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
         state.path(),
         Some(std::path::Path::new("/somewhere/sculpture.json"))
     );
-    assert_eq!(state.model(), orphan.model);
+    assert_eq!(state.surface().to_model(), orphan.model);
     // The orphan is gone; this editor's own autosave holds the work now.
     let own = app.recovery().unwrap().own_file().to_owned();
     assert!(own.exists());
@@ -626,7 +629,7 @@ fn ply_triangles(path: &std::path::Path) -> (usize, usize) {
 fn new_settings_refit_the_surface_and_undo_restores_it() {
     let _gpu = gpu_lock();
     let mut harness = harness();
-    let before = harness.state().state().unwrap().model();
+    let before = harness.state().state().unwrap().surface().clone();
     // The side panel's grid size, then Apply: a refit in the background.
     harness
         .get_by_label("Grid per chart")
@@ -646,7 +649,7 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
     );
     assert_eq!(state.control().len(), 6 * 12 * 12);
     // The refitted surface stays close to the old one.
-    let old = EditorState::new(&before, 24, 24).unwrap();
+    let old = EditorState::new(before.clone(), 24, 24).unwrap();
     let worst = old
         .mesh()
         .positions()
@@ -660,8 +663,8 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
     harness.run();
     let state = harness.state().state().unwrap();
     assert_eq!(
-        state.model(),
-        before,
+        state.surface().to_model(),
+        before.to_model(),
         "undo restores settings and control points"
     );
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);

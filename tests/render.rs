@@ -2,10 +2,10 @@
 //! non-trivial, styles differ as they should, and the same input gives the same bytes.
 
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Model, SplineSettings};
+use embedding::{SplineSettings, Surface};
 use ntori::render::{CurvatureKind, Image, Offscreen, RenderError, RenderOptions, Style, View};
 
-fn model() -> Model {
+fn model() -> Surface {
     let settings = SplineSettings {
         grid: 8,
         ..SplineSettings::default()

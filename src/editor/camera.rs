@@ -7,15 +7,16 @@
 use embedding::Point3;
 use glam::{DMat4, DVec2, DVec3, DVec4};
 
-use crate::render::Style;
+use crate::render::camera::{frame_uniforms, key_light};
 use crate::render::gpu::FrameUniforms;
+use crate::render::{Style, View};
 
 /// The vertical field of view, as `ntori render` uses.
-pub const FOV_DEG: f64 = 34.0;
+pub const FOV_DEG: f64 = crate::render::camera::FOV_DEG as f64;
 /// The default view: the same azimuth, elevation and distance (in bounding radii) as `ntori render`.
-pub const DEFAULT_AZIMUTH: f64 = 30.0;
-pub const DEFAULT_ELEVATION: f64 = 35.0;
-pub const DEFAULT_DISTANCE: f64 = 3.6;
+pub const DEFAULT_AZIMUTH: f64 = View::DEFAULT.azimuth_deg;
+pub const DEFAULT_ELEVATION: f64 = View::DEFAULT.elevation_deg;
+pub const DEFAULT_DISTANCE: f64 = View::DEFAULT.distance;
 
 /// A ray from the eye: origin and unit direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -191,20 +192,18 @@ impl OrbitCamera {
         }
     }
 
-    /// The GPU's uniforms for a viewport of `size` pixels.
+    /// The GPU's uniforms for a viewport of `size` pixels: the matrices in f64 rounded to f32, the
+    /// key light and the shading as offscreen pictures have them.
     pub fn uniforms(&self, style: Style, size: [u32; 2]) -> FrameUniforms {
         let size_f = [f64::from(size[0].max(1)), f64::from(size[1].max(1))];
-        let back = self.direction();
-        let (right, up) = self.basis();
-        let light = (back + 0.8 * up - 0.5 * right).normalize();
-        let wire = matches!(style, Style::Wireframe);
-        FrameUniforms {
-            view_proj: self.view_proj(size_f).as_mat4().to_cols_array_2d(),
-            eye: self.eye().as_vec3().extend(1.0).to_array(),
-            light: light.as_vec3().extend(0.0).to_array(),
-            params: [f32::from(u8::from(wire)), 1.2, 0.22, 0.25],
-            viewport: [size_f[0] as f32, size_f[1] as f32, 3.0, 2e-4],
-        }
+        frame_uniforms(
+            self.view_proj(size_f).as_mat4(),
+            self.eye().as_vec3(),
+            key_light(self.direction().as_vec3(), self.up().as_vec3()),
+            style,
+            [size_f[0] as f32, size_f[1] as f32],
+            3.0,
+        )
     }
 }
 

@@ -254,7 +254,11 @@ impl DragPlan {
     /// One drag event: the dragged point's new target. Solves and writes the new control points
     /// into `control` (start + change, for the touched ones); the vertices follow on the GPU from
     /// [`DragPlan::displacement`]. Returns the residual.
-    pub fn drag_to(&mut self, surface: &mut Surface, target: Point3) -> Result<f64, EmbeddingError> {
+    pub fn drag_to(
+        &mut self,
+        surface: &mut Surface,
+        target: Point3,
+    ) -> Result<f64, EmbeddingError> {
         let delta = target - self.start_position;
         let (moved, residual) = self.solve(&surface.layout(), delta)?;
         let mut updates: Vec<(ControlId, Point3)> = self

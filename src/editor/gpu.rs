@@ -1,14 +1,18 @@
-//! The viewport on the GPU: the renderer's surface shading (`shaders/surface.wgsl`, fragment stage)
-//! fed by a vertex stage that pulls shared vertices through an index buffer (`pulled.wgsl`), drawn
-//! into the editor's own colour, depth and multisample targets. egui shows the resolved colour target
-//! as a texture, so the 3D view has a depth buffer whatever egui's own pass has, and the same
-//! picture serves for screenshots and the tests.
+//! The viewport on the GPU: the renderer's surface shading (`shaders/frame.wgsl` and
+//! `shaders/surface.wgsl`, fragment stage) fed by a vertex stage that pulls shared vertices through
+//! an index buffer (`shaders/pulled.wgsl`), drawn into the editor's own colour, depth and
+//! multisample targets. egui shows the resolved colour target as a texture, so the 3D view has a
+//! depth buffer whatever egui's own pass has, and the same picture serves for screenshots and the
+//! tests. The uniforms, the pipeline, the targets and the read-back are the offscreen renderer's
+//! ([`crate::render::gpu`]).
 
 use embedding::Point3;
 
 use super::drag::DragRow;
 use super::mesh::LiveMesh;
-use crate::render::gpu::{DEPTH_FORMAT, FrameUniforms};
+use crate::render::gpu::{
+    FrameBinding, FrameUniforms, PipelineSpec, Targets, buffer_entry, pipeline, pipeline_layout,
+};
 use crate::render::{Image, RenderError};
 
 /// The colour format egui accepts for native textures.
@@ -27,20 +31,10 @@ struct MeshBuffers {
     group: wgpu::BindGroup,
 }
 
-/// The colour, resolve and depth targets for one size.
-struct Targets {
-    size: [u32; 2],
-    msaa: wgpu::TextureView,
-    resolved: wgpu::Texture,
-    resolved_view: wgpu::TextureView,
-    depth: wgpu::TextureView,
-}
-
 /// Pipelines, buffers and targets of the viewport.
 pub struct ViewportRenderer {
     pipeline: wgpu::RenderPipeline,
-    uniforms: wgpu::Buffer,
-    frame_group: wgpu::BindGroup,
+    frame: FrameBinding,
     mesh_layout: wgpu::BindGroupLayout,
     mesh: Option<MeshBuffers>,
     /// The drag rows of the last drag plan uploaded (its id), and the displacement uniform.
@@ -59,51 +53,16 @@ pub struct ViewportRenderer {
 
 impl ViewportRenderer {
     pub fn new(device: &wgpu::Device) -> ViewportRenderer {
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ntori editor frame"),
-            size: std::mem::size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ntori editor frame"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let storage = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let frame = FrameBinding::new(device, "ntori editor frame");
+        let vertex_buffer = |binding, ty| buffer_entry(binding, wgpu::ShaderStages::VERTEX, ty);
+        let storage = wgpu::BufferBindingType::Storage { read_only: true };
         let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ntori editor mesh"),
             entries: &[
-                storage(0),
-                storage(1),
-                storage(2),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::VERTEX,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                vertex_buffer(0, storage),
+                vertex_buffer(1, storage),
+                vertex_buffer(2, storage),
+                vertex_buffer(3, wgpu::BufferBindingType::Uniform),
             ],
         });
         let drag_uniform = device.create_buffer(&wgpu::BufferDescriptor {
@@ -113,71 +72,27 @@ impl ViewportRenderer {
             mapped_at_creation: false,
         });
         let drag_rows = drag_buffer(device, &[]);
-        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ntori editor frame"),
-            layout: &frame_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniforms.as_entire_binding(),
-            }],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("ntori editor"),
-            bind_group_layouts: &[Some(&frame_layout), Some(&mesh_layout)],
-            immediate_size: 0,
-        });
-        let source = format!(
-            "{}\n{}",
+        let layout = pipeline_layout(device, "ntori editor", &[frame.layout(), &mesh_layout]);
+        let source = concat!(
+            include_str!("../../shaders/frame.wgsl"),
             include_str!("../../shaders/surface.wgsl"),
-            include_str!("pulled.wgsl")
+            include_str!("../../shaders/pulled.wgsl")
         );
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("ntori editor surface"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("ntori editor surface"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_pulled"),
-                compilation_options: Default::default(),
+        let pipeline = pipeline(
+            device,
+            &layout,
+            PipelineSpec {
+                label: "ntori editor surface",
+                source,
+                vertex_entry: "vs_pulled",
                 buffers: &[],
+                format: COLOUR_FORMAT,
+                samples: SAMPLES,
             },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                // Two-sided: the shader lights whichever side faces the camera.
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: wgpu::MultisampleState {
-                count: SAMPLES,
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: COLOUR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         ViewportRenderer {
             pipeline,
-            uniforms,
-            frame_group,
+            frame,
             mesh_layout,
             mesh: None,
             drag_rows,
@@ -191,8 +106,6 @@ impl ViewportRenderer {
         }
     }
 
-    /// Brings the GPU's copy of the mesh up to date: new buffers after a new tessellation, else
-    /// only the vertex ranges that changed.
     /// Brings the GPU's copy of the mesh up to date: new buffers after a new tessellation, else
     /// only the vertex ranges that changed; and the drag in progress (its rows once per drag, the
     /// displacement every time). Returns whether anything the picture depends on changed.
@@ -290,11 +203,18 @@ impl ViewportRenderer {
         frame: &FrameUniforms,
     ) {
         let size = [size[0].max(1), size[1].max(1)];
-        if self.targets.as_ref().is_none_or(|t| t.size != size) {
-            self.targets = Some(targets(device, size));
+        if self.targets.as_ref().is_none_or(|t| t.size() != size) {
+            self.targets = Some(Targets::new(
+                device,
+                "ntori editor",
+                size,
+                COLOUR_FORMAT,
+                SAMPLES,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+            ));
             self.generation += 1;
         }
-        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(frame));
+        self.frame.write(queue, frame);
         let Some(targets) = &self.targets else {
             unreachable!("made above")
         };
@@ -303,34 +223,13 @@ impl ViewportRenderer {
         });
         {
             let [r, g, b] = BACKGROUND;
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("ntori editor viewport"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &targets.msaa,
-                    depth_slice: None,
-                    resolve_target: Some(&targets.resolved_view),
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
-                        store: wgpu::StoreOp::Discard,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &targets.depth,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let clear = wgpu::Color { r, g, b, a: 1.0 };
+            let mut pass = targets.begin_pass(&mut encoder, "ntori editor viewport", clear);
             if let Some(mesh) = &self.mesh
                 && mesh.index_count > 0
             {
                 pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &self.frame_group, &[]);
+                pass.set_bind_group(0, self.frame.group(), &[]);
                 pass.set_bind_group(1, &mesh.group, &[]);
                 pass.draw(0..mesh.index_count, 0..1);
             }
@@ -350,12 +249,12 @@ impl ViewportRenderer {
         let encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("ntori editor readback"),
         });
-        crate::render::read_texture(device, queue, encoder, &targets.resolved, targets.size)
+        targets.read_back(device, queue, encoder)
     }
 
     /// The resolved colour target, if anything was drawn.
     pub fn texture_view(&self) -> Option<&wgpu::TextureView> {
-        self.targets.as_ref().map(|t| &t.resolved_view)
+        self.targets.as_ref().map(Targets::view)
     }
 }
 
@@ -400,40 +299,5 @@ fn nonempty<T: bytemuck::Pod + bytemuck::Zeroable>(data: &[T]) -> std::borrow::C
         std::borrow::Cow::Owned(vec![T::zeroed()])
     } else {
         std::borrow::Cow::Borrowed(data)
-    }
-}
-
-fn targets(device: &wgpu::Device, [width, height]: [u32; 2]) -> Targets {
-    let texture = |label, format, samples, usage| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: samples,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-    };
-    let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let msaa = texture("ntori editor msaa", COLOUR_FORMAT, SAMPLES, attachment);
-    let resolved = texture(
-        "ntori editor picture",
-        COLOUR_FORMAT,
-        1,
-        attachment | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-    );
-    let depth = texture("ntori editor depth", DEPTH_FORMAT, SAMPLES, attachment);
-    Targets {
-        size: [width, height],
-        msaa: msaa.create_view(&Default::default()),
-        resolved_view: resolved.create_view(&Default::default()),
-        resolved,
-        depth: depth.create_view(&Default::default()),
     }
 }

@@ -327,7 +327,9 @@ impl LiveMesh {
                     CurvatureKind::Gaussian => k.gaussian,
                     CurvatureKind::Mean => k.mean,
                 }),
-                (_, Style::Charts, _) => vertex.colour = pack_colour(blend_colour(atlas, &s.blends)),
+                (_, Style::Charts, _) => {
+                    vertex.colour = pack_colour(blend_colour(atlas, &s.blends))
+                }
                 _ => vertex.colour = pack_colour(SURFACE_COLOUR),
             }
         };

@@ -7,14 +7,14 @@ use std::time::{Duration, Instant};
 
 use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
 use embedding::fit::{FitSettings, vertex_areas};
-use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
+use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
 use super::camera::{OrbitCamera, to_point};
 use super::drag::{DragPlan, DragRow};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
-use crate::io::model_file::{self, ModelFileError};
+use crate::io::model_file::ModelFileError;
 use crate::render::Style;
 
 /// What can go wrong in the editor.
@@ -469,7 +469,11 @@ impl EditorState {
             return;
         };
         let start = &drag.plan.start_control;
-        let restored = drag.plan.touched.iter().map(|&c| (ControlId(c), start[c as usize]));
+        let restored = drag
+            .plan
+            .touched
+            .iter()
+            .map(|&c| (ControlId(c), start[c as usize]));
         // The starting control points were valid, so restoring them cannot fail.
         if self.surface.set_control_points_at(restored).is_ok() {
             self.mesh.rows_changed(&self.surface, &drag.plan.rows);

@@ -4,7 +4,7 @@
 //! Models are made afresh by `embedding::fit::initial_model` (nothing is cached on disk) and kept in
 //! memory for the run, so the genus-2 fit serves figures 2, 6 and the gallery.
 
-use charts::{Atlas, ChartPoint, ModelPoint};
+use charts::{ChartPoint, ModelPoint};
 use embedding::edit::{Constraint, solve};
 use embedding::fit::{FitSettings, InitialFit, initial_model};
 use embedding::{Point3, SplineSettings, Surface};

@@ -1,5 +1,7 @@
 //! The camera of offscreen pictures: an orbit around the bounding sphere of what is drawn, and the
-//! key light that follows it.
+//! key light that follows it. The key light ([`key_light`]) and the uniforms ([`frame_uniforms`])
+//! serve the editor's orbit camera too (`editor::camera`), so a picture and the viewport are lit
+//! and shaded alike.
 
 use glam::{Mat4, Vec3};
 
@@ -15,8 +17,8 @@ pub struct Camera {
     pub aspect: f32,
 }
 
-/// The vertical field of view.
-const FOV_DEG: f32 = 34.0;
+/// The vertical field of view (the editor's too).
+pub const FOV_DEG: f32 = 34.0;
 
 impl Camera {
     /// Unit vector from the centre towards the eye (z is up).
@@ -49,27 +51,47 @@ impl Camera {
 
     /// The key light: above and to the left of the camera, towards the light.
     pub fn light(&self) -> Vec3 {
-        let back = self.direction();
-        let right = Vec3::Z.cross(back).try_normalize().unwrap_or(Vec3::X);
-        let up = back.cross(right);
-        (back + 0.8 * up - 0.5 * right).normalize()
+        key_light(self.direction(), Vec3::Z)
     }
 
     pub fn uniforms(&self, style: Style, size: (u32, u32)) -> FrameUniforms {
-        let wire = matches!(style, Style::Wireframe);
-        FrameUniforms {
-            view_proj: self.view_proj().to_cols_array_2d(),
-            eye: self.eye().extend(1.0).to_array(),
-            light: self.light().extend(0.0).to_array(),
-            params: [f32::from(u8::from(wire)), 1.2, 0.22, 0.25],
+        frame_uniforms(
+            self.view_proj(),
+            self.eye(),
+            self.light(),
+            style,
+            [size.0 as f32, size.1 as f32],
             // Curves stay readable when printed: about 1/180 of the picture's height, at least 3 px.
-            viewport: [
-                size.0 as f32,
-                size.1 as f32,
-                (size.1 as f32 / 180.0).max(3.0),
-                2e-4,
-            ],
-        }
+            (size.1 as f32 / 180.0).max(3.0),
+        )
     }
 }
 
+/// The key light (towards the light): above and to the left of a camera that looks along `-back`
+/// (`back`: the unit vector from what is seen towards the eye), with `up` the world's up as the
+/// camera holds it.
+pub fn key_light(back: Vec3, up: Vec3) -> Vec3 {
+    let right = up.cross(back).try_normalize().unwrap_or(Vec3::X);
+    let up = back.cross(right);
+    (back + 0.8 * up - 0.5 * right).normalize()
+}
+
+/// The per-frame uniforms (`shaders/frame.wgsl`) of every pipeline: the camera, the key
+/// light, the style's shading parameters, and the viewport's size and curve width in pixels.
+pub fn frame_uniforms(
+    view_proj: Mat4,
+    eye: Vec3,
+    light: Vec3,
+    style: Style,
+    viewport: [f32; 2],
+    curve_width: f32,
+) -> FrameUniforms {
+    let wire = matches!(style, Style::Wireframe);
+    FrameUniforms {
+        view_proj: view_proj.to_cols_array_2d(),
+        eye: eye.extend(1.0).to_array(),
+        light: light.extend(0.0).to_array(),
+        params: [f32::from(u8::from(wire)), 1.2, 0.22, 0.25],
+        viewport: [viewport[0], viewport[1], curve_width, 2e-4],
+    }
+}

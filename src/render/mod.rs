@@ -1,6 +1,6 @@
-//! The renderer: one wgpu pipeline set (`shaders/*.wgsl`) for the editor's viewport and for
-//! headless pictures. Offscreen it needs no window and no GPU: Mesa's software Vulkan (lavapipe)
-//! is enough, which is what CI uses.
+//! The renderer: one wgpu pipeline setup ([`gpu`], `shaders/*.wgsl`) and one camera model
+//! ([`camera`]) for the editor's viewport and for headless pictures. Offscreen it needs no window
+//! and no GPU: Mesa's software Vulkan (lavapipe) is enough, which is what CI uses.
 //!
 //! Styles: shaded; wireframe (the tessellation's edges over the shading); charts (each vertex
 //! coloured by its blend weights, one colour per chart); curvature (Gaussian or mean curvature on a
@@ -14,8 +14,8 @@ pub mod scene;
 
 use embedding::Surface;
 
-use gpu::{DEPTH_FORMAT, GpuScene, SurfaceRenderer};
 use camera::Camera;
+use gpu::{GpuScene, SurfaceRenderer, Targets};
 use scene::SceneGeometry;
 
 /// What can go wrong when rendering.
@@ -54,15 +54,18 @@ pub struct View {
 
 impl Default for View {
     fn default() -> Self {
-        View {
-            azimuth_deg: 30.0,
-            elevation_deg: 35.0,
-            distance: 3.6,
-        }
+        View::DEFAULT
     }
 }
 
 impl View {
+    /// The default view of `ntori render` and of the editor.
+    pub const DEFAULT: View = View {
+        azimuth_deg: 30.0,
+        elevation_deg: 35.0,
+        distance: 3.6,
+    };
+
     /// Checks the numbers: finite, elevation within ±90°, distance beyond the bounding sphere.
     pub fn validate(&self) -> Result<(), RenderError> {
         let finite = [self.azimuth_deg, self.elevation_deg, self.distance]
@@ -277,138 +280,25 @@ impl Offscreen {
                 (shift * glam::Mat4::from_cols_array_2d(&frame.view_proj)).to_cols_array_2d();
         }
         self.renderer.set_frame(&self.queue, &frame);
-        let target = |label, format, samples, usage| {
-            self.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let attachment = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let msaa = target("ntori msaa", OFFSCREEN_FORMAT, SAMPLES, attachment);
-        let resolved = target(
-            "ntori picture",
+        let targets = Targets::new(
+            &self.device,
+            "ntori",
+            [width, height],
             OFFSCREEN_FORMAT,
-            1,
-            attachment | wgpu::TextureUsages::COPY_SRC,
+            SAMPLES,
+            wgpu::TextureUsages::empty(),
         );
-        let depth = target("ntori depth", DEPTH_FORMAT, SAMPLES, attachment);
-        let views = [&msaa, &resolved, &depth].map(|t| t.create_view(&Default::default()));
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("ntori picture"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &views[0],
-                    depth_slice: None,
-                    resolve_target: Some(&views[1]),
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
-                        store: wgpu::StoreOp::Discard,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &views[2],
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = targets.begin_pass(&mut encoder, "ntori picture", wgpu::Color::WHITE);
             self.renderer.paint(&mut pass, &scene);
         }
-        let mut image = self.read_back(encoder, &resolved, width, height)?;
+        let mut image = targets.read_back(&self.device, &self.queue, encoder)?;
         if let Some((kind, range)) = geometry.legend {
             legend::draw(&mut image, kind, range);
         }
         Ok(image)
     }
-
-    fn read_back(
-        &self,
-        encoder: wgpu::CommandEncoder,
-        texture: &wgpu::Texture,
-        width: u32,
-        height: u32,
-    ) -> Result<Image, RenderError> {
-        read_texture(&self.device, &self.queue, encoder, texture, [width, height])
-    }
-}
-
-/// Copies a single-sampled RGBA8 texture into an [`Image`], after the commands in `encoder`.
-pub fn read_texture(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    mut encoder: wgpu::CommandEncoder,
-    texture: &wgpu::Texture,
-    [width, height]: [u32; 2],
-) -> Result<Image, RenderError> {
-    let row = 4 * width;
-    let padded =
-        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("ntori readback"),
-        size: u64::from(padded) * u64::from(height),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-    );
-    queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = sender.send(r);
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    receiver
-        .recv()
-        .map_err(|e| RenderError::Readback(e.to_string()))?
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let mut rgba = Vec::with_capacity((row * height) as usize);
-    for y in 0..height as usize {
-        let start = y * padded as usize;
-        rgba.extend_from_slice(&data[start..start + row as usize]);
-    }
-    drop(data);
-    buffer.unmap();
-    Ok(Image {
-        width,
-        height,
-        rgba,
-    })
 }

@@ -1,6 +1,7 @@
-// The editor's vertex stage, appended to shaders/surface.wgsl (whose fragment stage it feeds): shared
-// vertices pulled from storage buffers through the index buffer, so an edit rewrites each moved
-// vertex once, while every triangle corner still gets its barycentric coordinate for the wireframe.
+// The editor's vertex stage, appended to frame.wgsl and surface.wgsl (whose fragment stage it
+// feeds): shared vertices pulled from storage buffers through the index buffer, so an edit rewrites
+// each moved vertex once, while every triangle corner still gets its barycentric coordinate for the
+// wireframe.
 
 struct PulledVertex {
     px: f32, py: f32, pz: f32,

@@ -1,0 +1,403 @@
+//! What the user asks for: the keyboard, the menus, the side panel and the dialogs each add a
+//! [`Command`] while the frame's UI is drawn, and [`EditorApp::apply`] carries them out, in order,
+//! once the UI is done (the viewport's pointer input alone acts at once: a drag follows the pointer
+//! within its frame). A finished background job comes back as a command too.
+
+use std::path::{Path, PathBuf};
+
+use charts::ChartId;
+use egui::{Context, Key, KeyboardShortcut, Modifiers};
+use embedding::SplineSettings;
+
+use super::app::EditorApp;
+use super::jobs::{JobOutput, JobResult};
+use super::recovery::Recovery;
+use super::state::EditorState;
+use crate::render::{CurvatureKind, Style};
+
+/// A file the user is asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileAction {
+    Open,
+    SaveAs,
+    Export,
+    Screenshot,
+}
+
+impl FileAction {
+    pub fn title(self) -> &'static str {
+        match self {
+            FileAction::Open => "Open model",
+            FileAction::SaveAs => "Save model as",
+            FileAction::Export => "Export mesh",
+            FileAction::Screenshot => "Save screenshot",
+        }
+    }
+
+    pub fn button(self) -> &'static str {
+        match self {
+            FileAction::Open => "Open",
+            FileAction::SaveAs => "Save",
+            FileAction::Export => "Export",
+            FileAction::Screenshot => "Save",
+        }
+    }
+}
+
+/// An action that drops unsaved changes, so waits for the answer to "save changes?".
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pending {
+    /// A new model of this genus and settings.
+    New(u32, SplineSettings),
+    /// Open this file (None: ask for one).
+    Open(Option<PathBuf>),
+    Close,
+    /// Recover the i-th recovery file offered.
+    Recover(usize),
+}
+
+/// One user action.
+#[derive(Debug)]
+pub enum Command {
+    Undo,
+    Redo,
+    /// Save to the model's file (asking for one if it has none), then go on with the action.
+    Save(Option<Pending>),
+    /// Ask for a file for `action`, then go on with the action.
+    AskFile(FileAction, Option<Pending>),
+    /// The file for `action` was chosen.
+    FileChosen(FileAction, PathBuf, Option<Pending>),
+    /// An action, asking first about unsaved changes.
+    Guarded(Pending),
+    /// An action, the changes saved or dropped.
+    Run(Pending),
+    /// Open the new-model dialog with this genus and these settings.
+    NewModelDialog(u32, SplineSettings),
+    ToggleHelp,
+    ShowHelp,
+    /// Cancel the drag in progress, else close the dialogs.
+    Escape,
+    Quit,
+    Frame,
+    ResetView,
+    SetStyle(Style),
+    /// Show this chart's control net (None: none).
+    ShowControlNet(Option<ChartId>),
+    /// Show the next chart's control net (after the last: none).
+    NextControlNet,
+    /// Refit the surface to new spline settings (in the background).
+    Refit(SplineSettings),
+    SetTessellation(u32, u32),
+    RemovePin(usize),
+    ClearPins,
+    /// Delete the i-th recovery file offered and stop offering it.
+    DiscardOrphan(usize),
+    /// Stop offering the i-th recovery file (it stays for the next start).
+    DismissOrphan(usize),
+    /// The background job finished.
+    JobDone(JobResult),
+}
+
+/// Every shortcut, for the help window and the menus.
+pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("Left drag on the surface", "drag that point (pins hold)"),
+    ("Left drag on a pin", "drag the pinned point"),
+    ("Left drag elsewhere, Alt + left drag", "orbit"),
+    ("Right or middle drag, Shift + left drag", "pan"),
+    ("Mouse wheel, pinch, Ctrl + scroll", "zoom"),
+    ("Two fingers on a trackpad", "orbit (with Shift: pan)"),
+    ("Ctrl + click", "pin or unpin a point"),
+    ("Double click", "orbit about the clicked point"),
+    ("Esc", "cancel the drag in progress"),
+    ("F", "frame the model"),
+    ("Home", "reset the view"),
+    (
+        "1 2 3 4 5",
+        "shaded, wireframe, charts, Gaussian, mean curvature",
+    ),
+    ("C", "show the next chart's control points (then none)"),
+    ("Ctrl + Z", "undo"),
+    ("Ctrl + Shift + Z, Ctrl + Y", "redo"),
+    ("Ctrl + N", "new model"),
+    ("Ctrl + O", "open"),
+    ("Ctrl + S", "save"),
+    ("Ctrl + Shift + S", "save as"),
+    ("Ctrl + E", "export the mesh"),
+    ("F12", "screenshot of the viewport"),
+    ("F1", "this help"),
+    ("Ctrl + Q", "quit"),
+];
+
+/// The keyboard's commands this frame. `new_model` is what the new-model dialog starts with; the
+/// view's keys need a model.
+pub fn shortcuts(
+    ctx: &Context,
+    busy: bool,
+    has_model: bool,
+    new_model: (u32, SplineSettings),
+    commands: &mut Vec<Command>,
+) {
+    let consume = |modifiers, key| {
+        ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(modifiers, key)))
+    };
+    let command = |key| consume(Modifiers::COMMAND, key);
+    // The shifted forms first: Ctrl + Z also matches Ctrl + Shift + Z.
+    if consume(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z) || command(Key::Y) {
+        commands.push(Command::Redo);
+    }
+    if command(Key::Z) {
+        commands.push(Command::Undo);
+    }
+    if consume(Modifiers::COMMAND | Modifiers::SHIFT, Key::S) && !busy {
+        commands.push(Command::AskFile(FileAction::SaveAs, None));
+    }
+    if command(Key::S) && !busy {
+        commands.push(Command::Save(None));
+    }
+    if command(Key::O) && !busy {
+        commands.push(Command::Guarded(Pending::Open(None)));
+    }
+    if command(Key::N) && !busy {
+        commands.push(Command::NewModelDialog(new_model.0, new_model.1));
+    }
+    if command(Key::E) && !busy {
+        commands.push(Command::AskFile(FileAction::Export, None));
+    }
+    if command(Key::Q) {
+        commands.push(Command::Quit);
+    }
+    let plain = |key| consume(Modifiers::NONE, key);
+    if plain(Key::F12) {
+        commands.push(Command::AskFile(FileAction::Screenshot, None));
+    }
+    if plain(Key::F1) {
+        commands.push(Command::ToggleHelp);
+    }
+    if ctx.egui_wants_keyboard_input() {
+        return;
+    }
+    if plain(Key::Escape) {
+        commands.push(Command::Escape);
+    }
+    if !has_model {
+        return;
+    }
+    let keys = [
+        (Key::F, Command::Frame),
+        (Key::Home, Command::ResetView),
+        (Key::Num1, Command::SetStyle(Style::Shaded)),
+        (Key::Num2, Command::SetStyle(Style::Wireframe)),
+        (Key::Num3, Command::SetStyle(Style::Charts)),
+        (
+            Key::Num4,
+            Command::SetStyle(Style::Curvature(CurvatureKind::Gaussian)),
+        ),
+        (
+            Key::Num5,
+            Command::SetStyle(Style::Curvature(CurvatureKind::Mean)),
+        ),
+        (Key::C, Command::NextControlNet),
+    ];
+    for (key, command) in keys {
+        if plain(key) {
+            commands.push(command);
+        }
+    }
+}
+
+impl EditorApp {
+    /// Carries out one command.
+    pub(super) fn apply(&mut self, command: Command) {
+        match command {
+            Command::Undo => self.undo_redo(false),
+            Command::Redo => self.undo_redo(true),
+            Command::Save(then) => {
+                let path = self
+                    .state
+                    .as_ref()
+                    .and_then(|s| s.path())
+                    .map(Path::to_owned);
+                match path {
+                    Some(path) => self.save_as(&path, then),
+                    None => self.apply(Command::AskFile(FileAction::SaveAs, then)),
+                }
+            }
+            Command::AskFile(action, then) => {
+                let current = self.state.as_ref().and_then(EditorState::path);
+                if let Some(chosen) = self.dialogs.ask_file(action, then, current) {
+                    self.apply(chosen);
+                }
+            }
+            Command::FileChosen(action, path, then) => match action {
+                FileAction::Open => self.open_or_tell(&path),
+                FileAction::SaveAs => self.save_as(&path, then),
+                FileAction::Export => {
+                    if let Some(state) = &self.state {
+                        let surface = state.surface().clone();
+                        self.jobs.export(surface, state.tessellation(), path);
+                    }
+                }
+                FileAction::Screenshot => self.pending_screenshot = Some(path),
+            },
+            Command::Guarded(action) => {
+                if self.state.as_ref().is_some_and(EditorState::is_modified) {
+                    self.dialogs.unsaved = Some(action);
+                } else {
+                    self.apply(Command::Run(action));
+                }
+            }
+            Command::Run(action) => self.run(action),
+            Command::NewModelDialog(genus, settings) => {
+                self.dialogs.new_model = Some((genus, settings));
+            }
+            Command::ToggleHelp => self.dialogs.show_help = !self.dialogs.show_help,
+            Command::ShowHelp => self.dialogs.show_help = true,
+            Command::Escape => match &mut self.state {
+                Some(state) if state.drag().is_some() => {
+                    state.cancel_drag();
+                    self.viewport.end_interaction();
+                    self.messages.info("drag cancelled");
+                }
+                _ => self.dialogs.close(),
+            },
+            Command::Quit => self.close_now = true,
+            Command::Refit(settings) => {
+                if let Some(state) = &self.state {
+                    self.jobs.refit(state.surface().clone(), settings);
+                }
+            }
+            Command::DiscardOrphan(i) => {
+                if i < self.orphans.len() {
+                    Recovery::discard(&self.orphans.remove(i));
+                }
+            }
+            Command::DismissOrphan(i) => {
+                if i < self.orphans.len() {
+                    self.orphans.remove(i);
+                }
+            }
+            Command::JobDone(result) => self.finish_job(result),
+            command => self.apply_to_state(command),
+        }
+    }
+
+    /// The commands that change the model or its view alone.
+    fn apply_to_state(&mut self, command: Command) {
+        let Some(state) = &mut self.state else { return };
+        match command {
+            Command::Frame => state.frame(),
+            Command::ResetView => state.reset_view(),
+            Command::SetStyle(style) => state.set_style(style),
+            Command::ShowControlNet(chart) => state.control_chart = chart,
+            Command::NextControlNet => {
+                let charts = state.atlas().charts().len() as u32;
+                state.control_chart = match state.control_chart {
+                    None => Some(ChartId(0)),
+                    Some(c) if c.0 + 1 < charts => Some(ChartId(c.0 + 1)),
+                    Some(_) => None,
+                };
+            }
+            Command::SetTessellation(te, tr) => {
+                if let Err(e) = state.set_tessellation(te, tr) {
+                    self.messages.error(e.to_string());
+                }
+            }
+            Command::RemovePin(i) => state.remove_pin(i),
+            Command::ClearPins => state.clear_pins(),
+            _ => unreachable!("applied by EditorApp::apply"),
+        }
+    }
+
+    fn run(&mut self, action: Pending) {
+        match action {
+            Pending::New(genus, settings) => self.jobs.new_model(genus, settings),
+            Pending::Open(Some(path)) => self.open_or_tell(&path),
+            Pending::Open(None) => self.apply(Command::AskFile(FileAction::Open, None)),
+            Pending::Close => {
+                self.allow_close = true;
+                self.close_now = true;
+            }
+            Pending::Recover(i) => {
+                if let Err(e) = self.recover(i) {
+                    self.messages.error(format!("cannot recover: {e}"));
+                }
+            }
+        }
+    }
+
+    fn open_or_tell(&mut self, path: &Path) {
+        if let Err(e) = self.open(path) {
+            self.messages.error(e.to_string());
+        }
+    }
+
+    /// Saves to `path`, then goes on with `then`.
+    fn save_as(&mut self, path: &Path, then: Option<Pending>) {
+        match self.save_to(path) {
+            Ok(()) => {
+                self.messages.info(format!("saved {}", path.display()));
+                if let Some(next) = then {
+                    self.run(next);
+                }
+            }
+            Err(e) => self.messages.error(e.to_string()),
+        }
+    }
+
+    /// Undoes (or redoes) the last change, saying which.
+    fn undo_redo(&mut self, redo: bool) {
+        let Some(state) = &mut self.state else { return };
+        let (result, done, verb) = if redo {
+            (state.redo(), "redid", "redo")
+        } else {
+            (state.undo(), "undid", "undo")
+        };
+        match result {
+            Ok(Some(label)) => self.messages.info(format!("{done} {label}")),
+            Ok(None) => {}
+            Err(e) => self.messages.error(format!("cannot {verb}: {e}")),
+        }
+    }
+
+    fn finish_job(&mut self, result: JobResult) {
+        match result {
+            Ok(JobOutput::NewModel { genus, surface }) => {
+                let (te, tr) = self.current_t();
+                match EditorState::new(surface, te, tr) {
+                    Ok(state) => {
+                        self.install(state);
+                        self.messages.info(format!("new genus-{genus} model"));
+                    }
+                    Err(e) => self
+                        .messages
+                        .error(format!("cannot show the new model: {e}")),
+                }
+            }
+            Ok(JobOutput::Refit {
+                settings,
+                control,
+                worst,
+            }) => {
+                let Some(state) = &mut self.state else { return };
+                let size = state.size();
+                match state.set_settings(settings, control) {
+                    Ok(()) => {
+                        self.panel.settings_applied(settings);
+                        self.messages.info(format!(
+                            "refitted: the surface moved by at most {:.3}% of its size",
+                            100.0 * worst / size.max(f64::MIN_POSITIVE)
+                        ));
+                    }
+                    Err(e) => self
+                        .messages
+                        .error(format!("cannot use the new settings: {e}")),
+                }
+            }
+            Ok(JobOutput::Exported { triangles, path }) => self.messages.info(format!(
+                "exported {triangles} triangles to {}",
+                path.display()
+            )),
+            Err(e) => self.messages.error(e.to_string()),
+        }
+    }
+}

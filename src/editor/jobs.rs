@@ -1,0 +1,150 @@
+//! Work done off the UI thread: fitting a new model, refitting to new spline settings, exporting the
+//! mesh. One job at a time; its result comes back through a channel, and the app applies it
+//! ([`super::commands::Command::JobDone`]).
+
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::time::{Duration, Instant};
+
+use embedding::fit::{FitSettings, initial_model};
+use embedding::{EmbeddingError, Point3, SplineSettings, Surface};
+
+use super::state::{EditorError, refit};
+use crate::io::export::{self, Encoding, ExportError, Format};
+
+/// Resolution of the input meshes of new models (points around each hole), as `ntori new` uses.
+const NEW_MODEL_RESOLUTION: usize = 32;
+
+/// What a finished job produced.
+#[derive(Debug)]
+pub enum JobOutput {
+    /// A new model was fitted.
+    NewModel { genus: u32, surface: Surface },
+    /// The control points for `settings`, and how far the refitted surface lies from the old one
+    /// at most.
+    Refit {
+        settings: SplineSettings,
+        control: Vec<Point3>,
+        worst: f64,
+    },
+    /// The mesh was written.
+    Exported { triangles: usize, path: PathBuf },
+}
+
+/// Why a job failed.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    #[error("cannot make a genus-{genus} model: {source}")]
+    NewModel { genus: u32, source: EmbeddingError },
+    #[error("cannot refit: {0}")]
+    Refit(#[source] EditorError),
+    #[error("export failed: {0}")]
+    Export(#[from] ExportError),
+    #[error("a background job stopped unexpectedly")]
+    Stopped,
+}
+
+pub type JobResult = Result<JobOutput, JobError>;
+
+struct Job {
+    what: String,
+    started: Instant,
+    receiver: Receiver<JobResult>,
+}
+
+/// The background job, if one runs.
+#[derive(Default)]
+pub struct Jobs {
+    current: Option<Job>,
+}
+
+impl Jobs {
+    pub fn busy(&self) -> bool {
+        self.current.is_some()
+    }
+
+    /// What runs ("fitting a new genus-2 model"), and since when.
+    pub fn running(&self) -> Option<(&str, Instant)> {
+        self.current.as_ref().map(|j| (j.what.as_str(), j.started))
+    }
+
+    fn spawn(&mut self, what: String, work: impl FnOnce() -> JobResult + Send + 'static) {
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = sender.send(work());
+        });
+        self.current = Some(Job {
+            what,
+            started: Instant::now(),
+            receiver,
+        });
+    }
+
+    /// Fits a new model of `genus` (as `ntori new` does).
+    pub fn new_model(&mut self, genus: u32, settings: SplineSettings) {
+        self.spawn(format!("fitting a new genus-{genus} model"), move || {
+            let fit = initial_model(
+                genus,
+                NEW_MODEL_RESOLUTION,
+                settings,
+                FitSettings::default(),
+            )
+            .map_err(|source| JobError::NewModel { genus, source })?;
+            Ok(JobOutput::NewModel {
+                genus,
+                surface: fit.surface,
+            })
+        });
+    }
+
+    /// Refits `surface` with other spline settings.
+    pub fn refit(&mut self, surface: Surface, settings: SplineSettings) {
+        let what = format!(
+            "refitting to degree {}, C^{}, grid {}",
+            settings.degree, settings.continuity, settings.grid
+        );
+        self.spawn(what, move || {
+            let (control, worst) = refit(&surface, settings).map_err(JobError::Refit)?;
+            Ok(JobOutput::Refit {
+                settings,
+                control,
+                worst,
+            })
+        });
+    }
+
+    /// Writes the tessellation (t_e, t_r) of `surface` to `path`, in the format its extension
+    /// names.
+    pub fn export(&mut self, surface: Surface, (te, tr): (u32, u32), path: PathBuf) {
+        self.spawn("exporting".into(), move || {
+            let format = Format::from_path(&path)?;
+            let mesh = export::surface_mesh(&surface, te, tr)?;
+            export::write(&mesh, &path, format, Encoding::Binary)?;
+            Ok(JobOutput::Exported {
+                triangles: mesh.triangles.len(),
+                path,
+            })
+        });
+    }
+
+    /// The job's result if it is done; while it runs, a repaint is asked for soon.
+    pub fn poll(&mut self, ctx: &egui::Context) -> Option<JobResult> {
+        let job = self.current.as_ref()?;
+        let result = match job.receiver.try_recv() {
+            Ok(result) => result,
+            Err(TryRecvError::Empty) => {
+                ctx.request_repaint_after(Duration::from_millis(50));
+                return None;
+            }
+            Err(TryRecvError::Disconnected) => Err(JobError::Stopped),
+        };
+        self.current = None;
+        Some(result)
+    }
+
+    /// Blocks until the job, if any, is done, and returns its result.
+    pub fn wait(&mut self) -> Option<JobResult> {
+        let job = self.current.take()?;
+        Some(job.receiver.recv().unwrap_or(Err(JobError::Stopped)))
+    }
+}
