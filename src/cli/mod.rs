@@ -10,11 +10,9 @@ mod export;
 mod figures;
 mod info;
 mod new;
-#[cfg(test)]
-mod old_cli_check;
 mod render;
 mod report;
-mod tessellate; // TEMPORARY
+mod tessellate;
 
 /// ntori: smooth closed surfaces of any genus, built from charts glued by linear fractional maps.
 ///

@@ -1,8 +1,9 @@
-//! The egui application: a thin [`eframe::App`] that, each frame, lets its parts draw themselves
-//! (menu bar, status bar and side panel in `panels.rs`, the viewport in `viewport.rs`, the dialogs
-//! in `dialogs.rs`), collects the [`Command`]s they and the keyboard give, and applies them in order
-//! (`commands.rs`). Background jobs are in `jobs.rs`. Nothing here computes geometry: that is
-//! [`EditorState`]'s.
+//! The egui application: a thin [`eframe::App`] that, each frame, applies in order the [`Command`]s
+//! given since the last one (by the last frame's UI, a finished background job, the keyboard; see
+//! `commands.rs`), then lets its parts draw themselves and collects their commands: menu bar,
+//! status bar and side panel (`panels.rs`), the viewport (`viewport.rs`, whose pointer input acts at
+//! once), the dialogs (`dialogs.rs`). Background jobs are in `jobs.rs`. Nothing here computes
+//! geometry: that is [`EditorState`]'s.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -70,7 +71,7 @@ pub struct EditorApp {
     pub(super) messages: Messages,
     pub(super) recovery: Option<Recovery>,
     pub(super) orphans: Vec<Orphan>,
-    /// What this frame's UI asked for, applied in order once it is drawn.
+    /// What the UI asked for, applied in order at the start of the next frame.
     commands: Vec<Command>,
     timings: Timings,
     /// A close that needs no question (the changes were saved or dropped), and a close to ask for.
@@ -292,12 +293,12 @@ impl EditorApp {
         }
     }
 
-    /// A close asked for with unsaved changes is held until the user answers.
+    /// A close asked for with unsaved changes is held (in this frame) until the user answers.
     fn handle_close(&mut self, ctx: &Context) {
         let modified = self.state.as_ref().is_some_and(EditorState::is_modified);
         if ctx.input(|i| i.viewport().close_requested()) && !self.allow_close && modified {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.dialogs.unsaved = Some(Pending::Close);
+            self.commands.push(Command::Guarded(Pending::Close));
         }
     }
 
@@ -336,15 +337,23 @@ impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
+        // What was asked for since the last frame (its UI's commands, the finished job, a close, the
+        // keyboard), applied in order before anything is drawn: the keyboard acts before the
+        // viewport sees the pointer (Esc cancels a drag before egui's own end of it releases it).
         if let Some(result) = self.jobs.poll(&ctx) {
-            self.apply(Command::JobDone(result));
+            self.commands.push(Command::JobDone(result));
         }
         self.handle_close(&ctx);
+        let new_model = self.new_model_defaults();
+        let (busy, has_model) = (self.jobs.busy(), self.state.is_some());
+        commands::shortcuts(&ctx, busy, has_model, new_model, &mut self.commands);
+        for command in std::mem::take(&mut self.commands) {
+            self.apply(command);
+        }
 
         let busy = self.jobs.busy();
         let new_model = self.new_model_defaults();
         let commands = &mut self.commands;
-        commands::shortcuts(&ctx, busy, self.state.is_some(), new_model, commands);
         egui::Panel::top("menu").show(ui, |ui| {
             panels::menu_bar(ui, self.state.as_ref(), busy, new_model, commands);
         });
@@ -368,15 +377,11 @@ impl eframe::App for EditorApp {
         });
         let current = self.state.as_ref().and_then(EditorState::path);
         self.dialogs.ui(&ctx, current, &self.orphans, commands);
-
-        let commands = std::mem::take(&mut self.commands);
-        if !commands.is_empty() {
-            // What they changed shows in the next frame.
+        if !self.commands.is_empty() {
+            // They are applied at the start of the next frame.
             ctx.request_repaint();
         }
-        for command in commands {
-            self.apply(command);
-        }
+
         self.take_screenshot();
         self.autosave(false);
         self.update_title(&ctx);

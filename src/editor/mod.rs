@@ -17,7 +17,7 @@
 //! - `gpu.rs` — the viewport's pipeline (vertices pulled through the index buffer,
 //!   `shaders/pulled.wgsl`) over the renderer's shared GPU setup (`render::gpu`).
 //! - `app.rs` — the egui application: a thin `eframe::App` over the parts below, applying the
-//!   frame's commands once its UI is drawn.
+//!   commands given since the last frame before drawing the next.
 //! - `commands.rs` — the user's actions ([`commands::Command`]), the keyboard shortcuts, and the
 //!   one function that applies them.
 //! - `viewport.rs` — the viewport's pointer input, its picture and the overlays.
