@@ -1,7 +1,8 @@
 //! # ntori
 //!
-//! The application layer: the command line (and, in later work, the model file, meshes, export, the
-//! renderer and the editor) over the [`charts`] and [`embedding`] crates.
+//! The application layer over the [`charts`], [`mesh`] and [`embedding`] crates: files and exports
+//! ([`io`]), pictures ([`render`]), the paper's figures ([`figures`]) and the editor ([`editor`]).
+//! The command line is the binary's (`src/main.rs`, `src/cli/`); this library uses no anyhow.
 
 pub mod editor;
 pub mod figures;

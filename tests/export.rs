@@ -8,10 +8,10 @@ use std::sync::OnceLock;
 
 use embedding::fit::{FitSettings, initial_model};
 use embedding::{Model, SplineSettings, Surface};
+use mesh::HalfEdgeMesh;
 use ntori::io::export::{
     self, Encoding, ExportError, Format, MAX_RESOLUTION, SurfaceMesh, surface_mesh,
 };
-use mesh::HalfEdgeMesh;
 use ntori::io::model_file::{self, ModelFileError};
 
 /// Small fitted models (coarse grid and input mesh: seconds, not minutes), genus 0 to 3.

@@ -84,7 +84,15 @@ pub fn evaluate(
             (0..pts.len())
                 .map(|r| {
                     let jet = stencil.position_and_tangents(control, r);
-                    sample(&layout, control, first + r, pts[r], jet, wants, min_normal_length)
+                    sample(
+                        &layout,
+                        control,
+                        first + r,
+                        pts[r],
+                        jet,
+                        wants,
+                        min_normal_length,
+                    )
                 })
                 .collect()
         });
@@ -115,7 +123,15 @@ pub fn evaluate_rows(
                 .map(|&r| {
                     let r = r as usize;
                     let jet = stencil.position_and_tangents(control, r);
-                    sample(&layout, control, r, points[r], jet, wants, min_normal_length)
+                    sample(
+                        &layout,
+                        control,
+                        r,
+                        points[r],
+                        jet,
+                        wants,
+                        min_normal_length,
+                    )
                 })
                 .collect()
         });
@@ -198,9 +214,7 @@ pub fn parallel_chunks<T: Sync, U: Send>(
     work: impl Fn(&[T], &mut [U]) + Sync,
 ) {
     const MIN_PER_THREAD: usize = 16_384;
-    let threads = threads()
-        .min(input.len().div_ceil(MIN_PER_THREAD))
-        .max(1);
+    let threads = threads().min(input.len().div_ceil(MIN_PER_THREAD)).max(1);
     if threads == 1 {
         work(input, output);
         return;

@@ -180,7 +180,10 @@ impl Surface {
                 expected,
             });
         }
-        match control.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+        match control
+            .iter()
+            .position(|p| !p.iter().all(|x| x.is_finite()))
+        {
             Some(i) => Err(EmbeddingError::NotFinite(i)),
             None => Ok(()),
         }

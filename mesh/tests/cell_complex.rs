@@ -2,8 +2,8 @@
 //! printed: the validator must report every inconsistency in them, and the corrected complex must be a
 //! sphere. The cell-complex view of tessellations must be consistent too.
 
-use mesh::cell_complex::{Cell, CellComplex, Inconsistency};
 use mesh::HalfEdgeMesh;
+use mesh::cell_complex::{Cell, CellComplex, Inconsistency};
 
 /// Reads `tests/fixtures/ibm-example-complex.txt` (format described in the file).
 fn load_fixture() -> CellComplex {

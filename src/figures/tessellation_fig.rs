@@ -3,10 +3,10 @@
 use charts::{Atlas, ChartId, ChartsError, Tessellation};
 use num_complex::Complex64;
 
+use super::drawing::{drawn_triangles, fill, polygon_path};
 use super::geometry::domain_boundary;
 use super::svg::{Doc, Font, Frame, HEADING_FONT, Label, polyline_data, xy};
 use super::{COARSE, SUBDIVIDED};
-use super::drawing::{drawn_triangles, fill, polygon_path};
 
 /// The tessellation in the polygon, clipped to it, triangles coloured by home chart.
 fn in_polygon(doc: &mut Doc, atlas: &Atlas, t: &Tessellation, frame: Frame, id: &str, line: f64) {

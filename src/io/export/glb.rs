@@ -253,4 +253,3 @@ pub fn write_glb(mesh: &SurfaceMesh, out: &mut dyn Write) -> std::io::Result<()>
     }
     Ok(())
 }
-

@@ -226,12 +226,20 @@ pub fn surface_mesh(surface: &Surface, te: u32, tr: u32) -> Result<SurfaceMesh, 
         triangles: t.triangles,
     };
     let tiny = 1e-9 * size;
-    evaluate(surface, &t.vertices, Wants::default(), tiny * tiny, &mut |s: &Sample| {
-        mesh.positions.push(s.position.into());
-        mesh.normals.push(s.normal.map_or([f64::NAN; 3], Into::into));
-        mesh.uvs.push([s.point.coords.re + 0.5, s.point.coords.im + 0.5]);
-        mesh.charts.push(s.point.chart.0);
-    });
+    evaluate(
+        surface,
+        &t.vertices,
+        Wants::default(),
+        tiny * tiny,
+        &mut |s: &Sample| {
+            mesh.positions.push(s.position.into());
+            mesh.normals
+                .push(s.normal.map_or([f64::NAN; 3], Into::into));
+            mesh.uvs
+                .push([s.point.coords.re + 0.5, s.point.coords.im + 0.5]);
+            mesh.charts.push(s.point.chart.0);
+        },
+    );
     mesh.repair_normals()?;
     mesh.orient_outward();
     Ok(mesh)
@@ -412,4 +420,3 @@ pub fn write_to(
         Format::Off => write_off(mesh, out),
     }
 }
-
