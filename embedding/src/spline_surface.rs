@@ -65,28 +65,13 @@ impl Surface {
     /// The surface a model document describes, with every check a file needs (header, genus,
     /// settings, control point count, finiteness).
     pub fn from_model(model: &Model) -> Result<Surface, EmbeddingError> {
-        Surface::from_model_with_atlas(model, None)
-    }
-
-    /// Like [`Surface::from_model`], reusing `atlas` when it has the model's genus (an atlas of
-    /// genus 64 takes a tenth of a second to build).
-    pub fn from_model_with_atlas(
-        model: &Model,
-        atlas: Option<Arc<Atlas>>,
-    ) -> Result<Surface, EmbeddingError> {
         ModelHeader {
             format: model.format.clone(),
             version: model.version,
         }
         .check()?;
-        let atlas = match atlas {
-            Some(a) if a.genus() == model.genus => a,
-            _ => Arc::new(Atlas::new(model.genus)?),
-        };
-        let layout = Layout::new(&atlas, model.settings)?;
-        model.validate(&layout)?;
-        let control = model.points();
-        Surface::new(atlas, model.settings, control)
+        let atlas = Arc::new(Atlas::new(model.genus)?);
+        Surface::new(atlas, model.settings, model.points())
     }
 
     /// The model document of this surface (current format and version).
@@ -98,8 +83,10 @@ impl Surface {
     pub fn with_control_points(&self, control: Vec<Point3>) -> Result<Surface, EmbeddingError> {
         self.check_points(&control)?;
         Ok(Surface {
+            atlas: Arc::clone(&self.atlas),
+            settings: self.settings,
+            basis: self.basis,
             control,
-            ..self.clone_empty()
         })
     }
 
@@ -186,15 +173,6 @@ impl Surface {
         {
             Some(i) => Err(EmbeddingError::NotFinite(i)),
             None => Ok(()),
-        }
-    }
-
-    fn clone_empty(&self) -> Surface {
-        Surface {
-            atlas: Arc::clone(&self.atlas),
-            settings: self.settings,
-            basis: self.basis,
-            control: Vec::new(),
         }
     }
 }
