@@ -16,7 +16,7 @@
 //! use embedding::SplineSettings;
 //!
 //! let fit = initial_model(2, 24, SplineSettings::default(), FitSettings::default())?;
-//! assert_eq!(fit.model.genus, 2);
+//! assert_eq!(fit.surface.genus(), 2);
 //! assert!(fit.rms_residual < 0.01 * fit.mesh_diagonal);
 //! # Ok::<(), embedding::EmbeddingError>(())
 //! ```

@@ -7,15 +7,13 @@
 //! curvature): ∫ K dA = 2π(2 − 2n) for any closed surface of genus n.
 //!
 //! ```
-//! use charts::Atlas;
 //! use embedding::integrals::surface_integrals;
 //! use embedding::fit::{FitSettings, initial_model};
-//! use embedding::{Layout, SplineSettings};
+//! use embedding::SplineSettings;
 //!
 //! let fit = initial_model(0, 16, SplineSettings::default(), FitSettings::default())?;
-//! let atlas = Atlas::new(0)?;
-//! let layout = Layout::new(&atlas, fit.model.settings)?;
-//! let sums = surface_integrals(&layout, &fit.model.points(), 4);
+//! let surface = &fit.surface;
+//! let sums = surface_integrals(&surface.layout(), surface.control_points(), 4);
 //! assert!((sums.gaussian_curvature - 4.0 * std::f64::consts::PI).abs() < 1e-3);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
