@@ -6,30 +6,16 @@
 use std::io::Cursor;
 use std::sync::OnceLock;
 
-use embedding::fit::{FitSettings, initial_model};
-use embedding::{Model, SplineSettings, Surface};
+use embedding::{Model, Surface};
 use mesh::HalfEdgeMesh;
 use ntori::io::export::{
     self, Encoding, ExportError, Format, MAX_RESOLUTION, SurfaceMesh, surface_mesh,
 };
 use ntori::io::model_file::{self, ModelFileError};
 
-/// Small fitted models (coarse grid and input mesh: seconds, not minutes), genus 0 to 3.
-fn models() -> &'static [Surface] {
-    static MODELS: OnceLock<Vec<Surface>> = OnceLock::new();
-    MODELS.get_or_init(|| {
-        (0..=3)
-            .map(|genus| {
-                let settings = SplineSettings {
-                    grid: 8,
-                    ..Default::default()
-                };
-                initial_model(genus, 16, settings, FitSettings::default())
-                    .unwrap()
-                    .surface
-            })
-            .collect()
-    })
+/// Small fitted models, genus 0 to 3.
+fn models() -> Vec<&'static Surface> {
+    (0..=3).map(crate::common::small_model).collect()
 }
 
 /// The surface meshes the format tests write, at the default t_e = t_r = 16. (Much coarser
@@ -561,7 +547,7 @@ fn model_files_round_trip_and_report_what_is_wrong() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.json");
     model_file::save(&path, &models()[1]).unwrap();
-    assert_eq!(model_file::load(&path).unwrap(), models()[1]);
+    assert_eq!(model_file::load(&path).unwrap(), *models()[1]);
 
     let text = std::fs::read_to_string(&path).unwrap();
     let cases: [(&str, String); 6] = [

@@ -1,11 +1,10 @@
 //! `ntori bench` prints well-formed JSON with positive, finite figures.
 
-use assert_cmd::Command;
+use crate::common::ntori;
 
 #[test]
 fn bench_prints_json_figures() {
-    let out = Command::cargo_bin("ntori")
-        .unwrap()
+    let out = ntori()
         .args(["bench", "--quiet", "--vertices", "3000", "--genus", "3"])
         .output()
         .unwrap();
@@ -44,13 +43,8 @@ fn bench_prints_json_figures() {
 
 #[test]
 fn bench_refuses_absurd_sizes() {
-    Command::cargo_bin("ntori")
-        .unwrap()
-        .args(["bench", "--vertices", "0"])
-        .assert()
-        .code(2);
-    Command::cargo_bin("ntori")
-        .unwrap()
+    ntori().args(["bench", "--vertices", "0"]).assert().code(2);
+    ntori()
         .args(["bench", "--genus", "99", "--quiet"])
         .assert()
         .code(1);

@@ -4,12 +4,9 @@
 
 use std::path::Path;
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
-fn ntori() -> Command {
-    Command::cargo_bin("ntori").expect("the ntori binary is built")
-}
+use crate::common::ntori;
 
 const SVG: [&str; 6] = [
     "fig1-polygon.svg",

@@ -1,18 +1,11 @@
 //! The offscreen renderer on whatever adapter the machine has (Mesa's lavapipe in CI): pictures are
 //! non-trivial, styles differ as they should, and the same input gives the same bytes.
 
-use embedding::fit::{FitSettings, initial_model};
-use embedding::{SplineSettings, Surface};
+use embedding::Surface;
 use ntori::render::{CurvatureKind, Image, Offscreen, RenderError, RenderOptions, Style, View};
 
 fn model() -> Surface {
-    let settings = SplineSettings {
-        grid: 8,
-        ..SplineSettings::default()
-    };
-    initial_model(2, 16, settings, FitSettings::default())
-        .unwrap()
-        .surface
+    crate::common::small_model(2).clone()
 }
 
 fn offscreen() -> Offscreen {

@@ -4,29 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use assert_cmd::Command;
 use embedding::SplineSettings;
-use embedding::fit::{FitSettings, initial_model};
 use predicates::prelude::*;
 
-fn ntori() -> Command {
-    Command::cargo_bin("ntori").unwrap()
-}
+use crate::common::ntori;
 
 /// A small fitted genus-2 model, as JSON text.
 fn model_text() -> &'static str {
     static TEXT: OnceLock<String> = OnceLock::new();
-    TEXT.get_or_init(|| {
-        let settings = SplineSettings {
-            grid: 8,
-            ..Default::default()
-        };
-        let model = initial_model(2, 16, settings, FitSettings::default())
-            .unwrap()
-            .surface
-            .to_model();
-        serde_json::to_string(&model).unwrap()
-    })
+    TEXT.get_or_init(|| serde_json::to_string(&crate::common::small_model(2).to_model()).unwrap())
 }
 
 /// A temporary directory holding `model.json`.

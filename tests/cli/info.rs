@@ -1,11 +1,8 @@
 //! `ntori info` end to end: the binary as a user runs it.
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
-fn ntori() -> Command {
-    Command::cargo_bin("ntori").expect("the ntori binary is built")
-}
+use crate::common::ntori;
 
 #[test]
 fn default_info_describes_genus_two_and_passes_its_self_check() {

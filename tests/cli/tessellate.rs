@@ -1,11 +1,8 @@
 //! `ntori tessellate` end to end.
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
-fn ntori() -> Command {
-    Command::cargo_bin("ntori").expect("the ntori binary is built")
-}
+use crate::common::ntori;
 
 #[test]
 fn reports_counts_and_checks_as_json() {

@@ -1,11 +1,8 @@
 //! `ntori new`: writes a model that loads, refuses to overwrite, reports bad parameters clearly.
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
-fn ntori() -> Command {
-    Command::cargo_bin("ntori").unwrap()
-}
+use crate::common::ntori;
 
 #[test]
 fn new_writes_a_valid_model_and_passes_its_checks() {

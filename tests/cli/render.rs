@@ -1,11 +1,8 @@
 //! `ntori render`: a PNG from a model file; bad arguments and files are clear errors.
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
-fn ntori() -> Command {
-    Command::cargo_bin("ntori").unwrap()
-}
+use crate::common::ntori;
 
 #[test]
 fn render_writes_a_png_and_refuses_nonsense() {

@@ -1,0 +1,11 @@
+//! The root package as a library: export formats read back by other parsers, the figures, the fit,
+//! offscreen rendering and the tessellation. (One test binary, so wgpu is linked once.)
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod export;
+mod figures;
+mod fit;
+mod render;
+mod tessellation;
