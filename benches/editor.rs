@@ -16,7 +16,7 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Point3, SplineSettings, Surface};
+use embedding::{SplineSettings, Surface, Vector3};
 use ntori::editor::EditorState;
 use ntori::editor::state::Grab;
 use ntori::render::Style;
@@ -62,7 +62,7 @@ fn drag(c: &mut Criterion) {
         let mut target = move || {
             step = step.wrapping_add(1);
             let s = f64::from(step % 100) / 100.0;
-            start + Point3::new(0.05 * s, -0.03 * s, 0.04 * s) * size
+            start + Vector3::new(0.05 * s, -0.03 * s, 0.04 * s) * size
         };
         group.bench_function(BenchmarkId::new("drag_event", n), |b| {
             b.iter(|| state.drag_to_target(black_box(target())).unwrap())

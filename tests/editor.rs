@@ -11,7 +11,7 @@ use egui::{Event, Key, Modifiers, PointerButton, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Point3, SplineSettings, Surface};
+use embedding::{Point3, SplineSettings, Surface, Vector3};
 use ntori::editor::camera::Ray;
 use ntori::editor::pick::cast_all;
 use ntori::editor::recovery::{RECOVERY_FORMAT, Recovery, RecoveryFile};
@@ -246,7 +246,7 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
     let size = state.viewport;
     let normal = {
         let d = state.camera.direction();
-        Point3::new(d.x, d.y, d.z)
+        Vector3::new(d.x, d.y, d.z)
     };
     let on_plane = |pixel: [f64; 2]| {
         let ray = state.camera.ray(pixel, size);
@@ -278,7 +278,7 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
     }
     // The redraw: every vertex equals its stencil row, and the GPU copy agrees (f32).
     let mesh = state.mesh();
-    let mut full = vec![Point3::zeros(); mesh.vertex_count()];
+    let mut full = vec![Point3::origin(); mesh.vertex_count()];
     mesh.stencil().positions(state.control(), &mut full);
     for (k, (a, b)) in mesh.positions().iter().zip(&full).enumerate() {
         assert!((a - b).norm() <= 1e-12 * model_size, "vertex {k}");
@@ -300,7 +300,7 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
             v.position[2].into(),
         );
         assert!((p - exact).norm() < 1e-5 * model_size, "vertex {r}");
-        let n = Point3::new(v.normal[0].into(), v.normal[1].into(), v.normal[2].into());
+        let n = Vector3::new(v.normal[0].into(), v.normal[1].into(), v.normal[2].into());
         let [u, w] = mesh.tangents()[r as usize];
         assert!((n - u.cross(&w).normalize()).norm() < 1e-4, "normal {r}");
     }
@@ -346,7 +346,7 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
         "the drag showed on screen ({changed} pixels differ from the undone surface)"
     );
     let state = harness.state().state().unwrap();
-    let mut full = vec![Point3::zeros(); state.mesh().vertex_count()];
+    let mut full = vec![Point3::origin(); state.mesh().vertex_count()];
     state.mesh().stencil().positions(state.control(), &mut full);
     assert!(
         state
@@ -374,7 +374,7 @@ fn save_then_open_round_trips_exactly() {
         state
             .start_drag(vertex, ntori::editor::state::Grab::Surface, pixel)
             .unwrap();
-        let target = state.surface_point(vertex) + Point3::new(0.1, -0.05, 0.2);
+        let target = state.surface_point(vertex) + Vector3::new(0.1, -0.05, 0.2);
         state.drag_to_target(target).unwrap();
         state.release();
         assert!(state.is_modified());
@@ -409,7 +409,7 @@ fn closing_with_unsaved_changes_asks_first() {
             .start_drag(vertex, ntori::editor::state::Grab::Surface, pixel)
             .unwrap();
         state
-            .drag_to_target(state.surface_point(vertex) + Point3::new(0.0, 0.0, 0.1))
+            .drag_to_target(state.surface_point(vertex) + Vector3::new(0.0, 0.0, 0.1))
             .unwrap();
         state.release();
     }
@@ -773,7 +773,7 @@ fn the_influence_radius_widens_the_edit_and_keeps_the_constraints() {
         state.influence = influence;
         let before = state.control().to_vec();
         state.start_drag(point, Grab::Surface, pixel).unwrap();
-        let target = state.surface_point(point) + Point3::new(0.02, 0.03, 0.08) * size;
+        let target = state.surface_point(point) + Vector3::new(0.02, 0.03, 0.08) * size;
         state.drag_to_target(target).unwrap();
         state.release();
         assert!((state.surface_point(point) - target).norm() < 1e-6 * size);

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use charts::{Atlas, ChartPoint};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use embedding::{Layout, Point3, SplineSettings, Stencil};
+use embedding::{Layout, Point3, SplineSettings, Stencil, Vector3};
 
 const SIZES: [usize; 3] = [10_000, 100_000, 1_000_000];
 
@@ -72,7 +72,7 @@ fn reembed(c: &mut Criterion) {
         .map(|&n| Stencil::build(&layout, &points(&atlas, n)))
         .collect();
     for (n, s) in SIZES.iter().zip(&stencils) {
-        let mut out = vec![Point3::zeros(); s.rows()];
+        let mut out = vec![Point3::origin(); s.rows()];
         full.throughput(Throughput::Elements(s.rows() as u64));
         full.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter(|| s.positions(black_box(&control), &mut out))
@@ -82,13 +82,13 @@ fn reembed(c: &mut Criterion) {
     let mut partial = c.benchmark_group("reembed_one_control_point");
     for (n, s) in SIZES.iter().zip(&stencils) {
         let index = s.column_index(layout.control_count());
-        let mut out = vec![Point3::zeros(); s.rows()];
+        let mut out = vec![Point3::origin(); s.rows()];
         s.positions(&control, &mut out);
         // A control point of the inside chart's patch, near its middle: it touches many vertices.
         let moved = layout.control_index(charts::ChartId(0), 4, 4);
         partial.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter(|| {
-                let delta = Point3::new(1e-3, 0.0, -1e-3);
+                let delta = Vector3::new(1e-3, 0.0, -1e-3);
                 control[moved] += delta;
                 s.update(&index, moved, black_box(delta), &mut out);
             })
@@ -119,7 +119,7 @@ fn bandwidth_report(_: &mut Criterion) {
     let bandwidth = copy_bandwidth();
     for n in SIZES {
         let s = Stencil::build(&layout, &points(&atlas, n));
-        let mut out = vec![Point3::zeros(); s.rows()];
+        let mut out = vec![Point3::origin(); s.rows()];
         let best = (0..5)
             .map(|_| {
                 let t = Instant::now();
@@ -155,7 +155,7 @@ fn drag_event(c: &mut Criterion) {
         let pts = points(&atlas, n);
         let s = Stencil::build(&layout, &pts);
         let index = s.column_index(layout.control_count());
-        let mut out = vec![Point3::zeros(); s.rows()];
+        let mut out = vec![Point3::origin(); s.rows()];
         s.positions(&control, &mut out);
         let (dragged, pins) = (pts[n / 3], [pts[n / 7], pts[n / 2]]);
         let mut scratch = RefreshScratch::default();
@@ -165,7 +165,7 @@ fn drag_event(c: &mut Criterion) {
                 step += 1e-4;
                 let mut constraints = vec![Constraint {
                     point: dragged,
-                    target: out[n / 3] + Point3::new(step, 0.0, 0.0),
+                    target: out[n / 3] + Vector3::new(step, 0.0, 0.0),
                 }];
                 constraints.extend(pins.iter().map(|&p| Constraint {
                     point: p,

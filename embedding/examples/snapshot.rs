@@ -4,7 +4,7 @@
 //! z-buffer and two-sided Lambert shading; `mesh` draws the input mesh instead.
 use charts::Atlas;
 use embedding::fit::{FitSettings, initial_model};
-use embedding::{Layout, Point3, SplineSettings, Stencil};
+use embedding::{Layout, Point3, SplineSettings, Stencil, Vector3};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -38,7 +38,7 @@ fn main() {
     );
     let mut colours: Vec<[f64; 3]> = Vec::new();
     let (pos, nor, tris) = if show_mesh {
-        let n = vec![Point3::zeros(); fit.mesh.positions.len()];
+        let n = vec![Vector3::zeros(); fit.mesh.positions.len()];
         (fit.mesh.positions.clone(), n, fit.mesh.triangles.clone())
     } else {
         let atlas = Atlas::new(genus).unwrap();
@@ -46,8 +46,8 @@ fn main() {
         let t = atlas.tessellate(24, 24).unwrap();
         let stencil = Stencil::build(&layout, &t.vertices);
         let control = fit.surface.control_points().to_vec();
-        let mut pos = vec![Point3::zeros(); t.vertices.len()];
-        let mut nor = pos.clone();
+        let mut pos = vec![Point3::origin(); t.vertices.len()];
+        let mut nor = vec![Vector3::zeros(); t.vertices.len()];
         stencil.positions(&control, &mut pos);
         stencil.normals(&control, &mut nor);
         if show_charts {
@@ -80,23 +80,24 @@ fn main() {
     };
     let (w, h) = (900usize, 700usize);
     // View: rotate about z by the azimuth, then tilt by the elevation; look down −y'.
-    let view = |p: &Point3| {
+    // Positions and normals alike, as vectors (a rotation).
+    let view = |p: &Vector3| {
         let (x, y) = (
             p.x * az.cos() - p.y * az.sin(),
             p.x * az.sin() + p.y * az.cos(),
         );
         let (y2, z2) = (y * el.cos() - p.z * el.sin(), y * el.sin() + p.z * el.cos());
-        Point3::new(x, z2, y2) // screen x, screen y (up), depth (towards the viewer is smaller)
+        Vector3::new(x, z2, y2) // screen x, screen y (up), depth (towards the viewer is smaller)
     };
-    let v: Vec<Point3> = pos.iter().map(view).collect();
-    let (mut lo, mut hi) = (Point3::repeat(f64::MAX), Point3::repeat(f64::MIN));
+    let v: Vec<Vector3> = pos.iter().map(|p| view(&p.coords)).collect();
+    let (mut lo, mut hi) = (Vector3::repeat(f64::MAX), Vector3::repeat(f64::MIN));
     for p in &v {
         lo = lo.inf(p);
         hi = hi.sup(p);
     }
     let scale = 0.9 * (w as f64 / (hi.x - lo.x)).min(h as f64 / (hi.y - lo.y));
     let centre = (lo + hi) / 2.0;
-    let px = |p: &Point3| {
+    let px = |p: &Vector3| {
         (
             w as f64 / 2.0 + (p.x - centre.x) * scale,
             h as f64 / 2.0 - (p.y - centre.y) * scale,
@@ -104,7 +105,7 @@ fn main() {
     };
     let mut depth = vec![f64::MAX; w * h];
     let mut rgb = vec![255u8; w * h * 3];
-    let light = Point3::new(-0.4, 0.8, -0.6).normalize(); // in view space
+    let light = Vector3::new(-0.4, 0.8, -0.6).normalize(); // in view space
     for t in &tris {
         let [a, b, c] = t.map(|i| v[i as usize]);
         let (pa, pb, pc) = (px(&a), px(&b), px(&c));

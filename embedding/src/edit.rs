@@ -11,8 +11,9 @@ use charts::ChartPoint;
 use nalgebra::{DMatrix, DVector};
 
 use crate::EmbeddingError;
+use crate::spline_surface::ControlId;
 use crate::stencil::{ColumnIndex, Stencil};
-use crate::surface::{Layout, Point3, Weight};
+use crate::surface::{Layout, Point3, Vector3, Weight};
 
 /// Move the surface point `point` to `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,8 +25,8 @@ pub struct Constraint {
 /// The change to make: control point `controls[k]` moves by `deltas[k]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Edit {
-    pub controls: Vec<u32>,
-    pub deltas: Vec<Point3>,
+    pub controls: Vec<ControlId>,
+    pub deltas: Vec<Vector3>,
     /// The largest |S(p_i) − t_i| left after the edit (0 up to rounding unless constraints conflict).
     pub residual: f64,
 }
@@ -34,7 +35,7 @@ impl Edit {
     /// Adds the change to the control points.
     pub fn apply(&self, control: &mut [Point3]) {
         for (&c, d) in self.controls.iter().zip(&self.deltas) {
-            control[c as usize] += d;
+            control[c.index()] += d;
         }
     }
 }
@@ -65,12 +66,12 @@ pub fn solve(
     let mut r = DMatrix::<f64>::zeros(m, k);
     let mut d = DMatrix::<f64>::zeros(m, 3);
     for (i, row) in rows.iter().enumerate() {
-        let mut current = Point3::zeros();
+        let mut current = Vector3::zeros();
         for w in row {
             r[(i, column(w.control))] += w.jet.val;
-            current += control[w.control as usize] * w.jet.val;
+            current += control[w.control as usize].coords * w.jet.val;
         }
-        let gap = constraints[i].target - current;
+        let gap = constraints[i].target - Point3::from(current);
         for a in 0..3 {
             d[(i, a)] = gap[a];
         }
@@ -87,9 +88,9 @@ pub fn solve(
         .fold(0.0, f64::max);
     Ok(Edit {
         deltas: (0..k)
-            .map(|j| Point3::new(delta[(j, 0)], delta[(j, 1)], delta[(j, 2)]))
+            .map(|j| Vector3::new(delta[(j, 0)], delta[(j, 1)], delta[(j, 2)]))
             .collect(),
-        controls,
+        controls: controls.into_iter().map(ControlId).collect(),
         residual,
     })
 }
@@ -124,7 +125,7 @@ pub fn refresh(
     let touched: usize = edit
         .controls
         .iter()
-        .map(|&c| stencil.rows_of(index, c as usize).len())
+        .map(|&c| stencil.rows_of(index, c.index()).len())
         .sum();
     scratch.rows.clear();
     if touched > rows {
@@ -134,7 +135,7 @@ pub fn refresh(
     }
     scratch.marked.resize(rows.div_ceil(64), 0);
     for &c in &edit.controls {
-        for &r in stencil.rows_of(index, c as usize) {
+        for &r in stencil.rows_of(index, c.index()) {
             let (word, bit) = (r as usize / 64, 1u64 << (r % 64));
             if scratch.marked[word] & bit == 0 {
                 scratch.marked[word] |= bit;

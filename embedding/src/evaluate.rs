@@ -13,7 +13,7 @@ use charts::{ChartId, ChartPoint};
 
 use crate::spline_surface::Surface;
 use crate::stencil::Stencil;
-use crate::surface::{Layout, Point3};
+use crate::surface::{Layout, Point3, Vector3};
 
 /// What a sink needs beyond position, tangents and normal.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -39,11 +39,11 @@ pub struct Sample {
     pub point: ChartPoint,
     pub position: Point3,
     /// S_u and S_v in the point's own chart.
-    pub du: Point3,
-    pub dv: Point3,
+    pub du: Vector3,
+    pub dv: Vector3,
     /// S_u × S_v / |S_u × S_v|, or `None` where |S_u × S_v| is below the evaluation's threshold
     /// (the surface is pinched there and has no tangent plane).
-    pub normal: Option<Point3>,
+    pub normal: Option<Vector3>,
     /// With [`Wants::curvature`].
     pub curvature: Option<Curvatures>,
     /// With [`Wants::blends`]: (chart, normalised weight) for every chart holding the point.
@@ -144,7 +144,7 @@ fn sample(
     control: &[Point3],
     index: usize,
     point: ChartPoint,
-    [position, du, dv]: [Point3; 3],
+    (position, [du, dv]): (Point3, [Vector3; 2]),
     wants: Wants,
     min_normal_length: f64,
 ) -> Sample {

@@ -164,14 +164,7 @@ pub fn initial_model(
 
 /// The bounding-box diagonal of a point set.
 pub fn diagonal(points: &[Point3]) -> f64 {
-    let (mut lo, mut hi) = (
-        Point3::repeat(f64::INFINITY),
-        Point3::repeat(f64::NEG_INFINITY),
-    );
-    for p in points {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
+    let (lo, hi) = crate::surface::bounding_box(points);
     (hi - lo).norm()
 }
 
@@ -378,7 +371,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
         .positions
         .iter()
         .map(|p| {
-            let r = p.norm();
+            let r = p.coords.norm();
             let xy = Complex64::new(p.x, p.y);
             if p.z >= 0.0 {
                 ChartPoint::new(north.id(), xy / ((r + p.z) * north.scale()))

@@ -37,7 +37,7 @@ pub use evaluate::{Curvatures, Sample, SampleSink, Wants, evaluate, evaluate_row
 pub use model::{MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader};
 pub use spline_surface::{ControlId, Surface};
 pub use stencil::{ColumnIndex, Stencil};
-pub use surface::{Jet, Layout, Point3, SplineSettings, SurfaceJet, Weight};
+pub use surface::{Jet, Layout, Point3, SplineSettings, SurfaceJet, Vector3, Weight, bounding_box};
 
 pub use charts;
 

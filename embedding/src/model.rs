@@ -58,11 +58,11 @@ impl Model {
     pub fn from_points(layout: &Layout, points: &[Point3]) -> Model {
         Model {
             control_points: points.iter().map(|p| [p.x, p.y, p.z]).collect(),
-            ..Model::constant(layout, Point3::zeros())
+            ..Model::constant(layout, Point3::origin())
         }
     }
 
-    /// The control points as vectors.
+    /// The control points as positions.
     pub fn points(&self) -> Vec<Point3> {
         self.control_points
             .iter()

@@ -149,14 +149,7 @@ impl Surface {
 
     /// The diagonal of the control points' bounding box: the scale derivatives in chart units have.
     pub fn control_net_size(&self) -> f64 {
-        let (lo, hi) = self.control.iter().fold(
-            (
-                Point3::repeat(f64::INFINITY),
-                Point3::repeat(f64::NEG_INFINITY),
-            ),
-            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-        );
-        (hi - lo).norm()
+        crate::fit::diagonal(&self.control)
     }
 
     fn check_points(&self, control: &[Point3]) -> Result<(), EmbeddingError> {
@@ -169,7 +162,7 @@ impl Surface {
         }
         match control
             .iter()
-            .position(|p| !p.iter().all(|x| x.is_finite()))
+            .position(|p| !p.coords.iter().all(|x| x.is_finite()))
         {
             Some(i) => Err(EmbeddingError::NotFinite(i)),
             None => Ok(()),

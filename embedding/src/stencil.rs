@@ -7,7 +7,7 @@
 
 use charts::ChartPoint;
 
-use crate::surface::{Layout, Point3, Weight};
+use crate::surface::{Layout, Point3, Vector3, Weight};
 
 /// Sparse weights, one row per surface point.
 #[derive(Clone, Debug, Default)]
@@ -70,25 +70,26 @@ impl Stencil {
     /// Row r of W · control.
     #[inline]
     pub fn position(&self, control: &[Point3], r: usize) -> Point3 {
-        let mut acc = Point3::zeros();
+        // The weights of a row sum to one: an affine combination, accumulated from the origin.
+        let mut acc = Vector3::zeros();
         for k in self.offsets[r]..self.offsets[r + 1] {
-            acc += control[self.controls[k] as usize] * self.pos[k];
+            acc += control[self.controls[k] as usize].coords * self.pos[k];
         }
-        acc
+        Point3::from(acc)
     }
 
     /// Row r of W, W_u and W_v times `control` in one pass: the position and the first derivatives
     /// S_u, S_v (in the row's own chart) of one surface point.
     #[inline]
-    pub fn position_and_tangents(&self, control: &[Point3], r: usize) -> [Point3; 3] {
-        let (mut p, mut a, mut b) = (Point3::zeros(), Point3::zeros(), Point3::zeros());
+    pub fn position_and_tangents(&self, control: &[Point3], r: usize) -> (Point3, [Vector3; 2]) {
+        let (mut p, mut a, mut b) = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
         for k in self.offsets[r]..self.offsets[r + 1] {
-            let c = control[self.controls[k] as usize];
+            let c = control[self.controls[k] as usize].coords;
             p += c * self.pos[k];
             a += c * self.du[k];
             b += c * self.dv[k];
         }
-        [p, a, b]
+        (Point3::from(p), [a, b])
     }
 
     /// Row r's weights: each control point it uses with its weight and the weight's u and v
@@ -117,11 +118,11 @@ impl Stencil {
     }
 
     /// S_u and S_v (in each point's own chart) = W_u · control, W_v · control.
-    pub fn derivatives(&self, control: &[Point3], du: &mut [Point3], dv: &mut [Point3]) {
+    pub fn derivatives(&self, control: &[Point3], du: &mut [Vector3], dv: &mut [Vector3]) {
         for r in 0..self.rows() {
-            let (mut a, mut b) = (Point3::zeros(), Point3::zeros());
+            let (mut a, mut b) = (Vector3::zeros(), Vector3::zeros());
             for k in self.offsets[r]..self.offsets[r + 1] {
-                let c = control[self.controls[k] as usize];
+                let c = control[self.controls[k] as usize].coords;
                 a += c * self.du[k];
                 b += c * self.dv[k];
             }
@@ -131,9 +132,9 @@ impl Stencil {
     }
 
     /// Unit normals S_u × S_v / |S_u × S_v|.
-    pub fn normals(&self, control: &[Point3], out: &mut [Point3]) {
-        let mut du = vec![Point3::zeros(); self.rows()];
-        let mut dv = vec![Point3::zeros(); self.rows()];
+    pub fn normals(&self, control: &[Point3], out: &mut [Vector3]) {
+        let mut du = vec![Vector3::zeros(); self.rows()];
+        let mut dv = vec![Vector3::zeros(); self.rows()];
         self.derivatives(control, &mut du, &mut dv);
         for (o, (a, b)) in out.iter_mut().zip(du.iter().zip(&dv)) {
             *o = a.cross(b).normalize();
@@ -172,7 +173,7 @@ impl Stencil {
         &self,
         index: &ColumnIndex,
         control: usize,
-        delta: Point3,
+        delta: Vector3,
         positions: &mut [Point3],
     ) {
         for k in index.offsets[control]..index.offsets[control + 1] {

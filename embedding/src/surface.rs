@@ -6,15 +6,30 @@
 //! stencils are the same numbers.
 
 use charts::{Atlas, ChartId, ChartPoint, Domain, Lft};
-use nalgebra::Vector3;
 use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
 use crate::EmbeddingError;
 use crate::bspline::{UniformBasis, cardinal};
 
-/// A point of R³ (a surface position, a control point). Distinct from chart and model points.
-pub type Point3 = Vector3<f64>;
+/// A position in R³: a point of the surface, a control point. Distinct from chart and model points,
+/// and from [`Vector3`]: positions subtract to vectors, and only vectors add, scale and cross.
+pub type Point3 = nalgebra::Point3<f64>;
+
+/// A vector in R³: a derivative of the surface, a normal, a displacement.
+pub type Vector3 = nalgebra::Vector3<f64>;
+
+/// The least and greatest corners of the axis-aligned box around `points` ((+∞, −∞) when there
+/// are none).
+pub fn bounding_box(points: &[Point3]) -> (Point3, Point3) {
+    points.iter().fold(
+        (
+            Point3::from([f64::INFINITY; 3]),
+            Point3::from([f64::NEG_INFINITY; 3]),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    )
+}
 
 /// The spline and blend parameters of a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -109,16 +124,16 @@ impl Jet {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfaceJet {
     pub pos: Point3,
-    pub du: Point3,
-    pub dv: Point3,
-    pub duu: Point3,
-    pub duv: Point3,
-    pub dvv: Point3,
+    pub du: Vector3,
+    pub dv: Vector3,
+    pub duu: Vector3,
+    pub duv: Vector3,
+    pub dvv: Vector3,
 }
 
 impl SurfaceJet {
     /// The unit normal S_u × S_v / |S_u × S_v| (outward for a positively oriented embedding).
-    pub fn normal(&self) -> Point3 {
+    pub fn normal(&self) -> Vector3 {
         self.du.cross(&self.dv).normalize()
     }
     /// First fundamental form (E, F, G).
@@ -314,16 +329,17 @@ impl<'a> Layout<'a> {
         let mut weights = Vec::with_capacity(64);
         self.weights(p, &mut weights);
         let mut s = SurfaceJet {
-            pos: Point3::zeros(),
-            du: Point3::zeros(),
-            dv: Point3::zeros(),
-            duu: Point3::zeros(),
-            duv: Point3::zeros(),
-            dvv: Point3::zeros(),
+            pos: Point3::origin(),
+            du: Vector3::zeros(),
+            dv: Vector3::zeros(),
+            duu: Vector3::zeros(),
+            duv: Vector3::zeros(),
+            dvv: Vector3::zeros(),
         };
+        // The weights sum to one (an affine combination), so the position accumulates from the origin.
         for w in &weights {
-            let c = control[w.control as usize];
-            s.pos += c * w.jet.val;
+            let c = control[w.control as usize].coords;
+            s.pos.coords += c * w.jet.val;
             s.du += c * w.jet.du;
             s.dv += c * w.jet.dv;
             s.duu += c * w.jet.duu;

@@ -3,7 +3,7 @@
 
 use charts::{Atlas, ChartId, ChartPoint};
 use embedding::edit::{Constraint, RefreshScratch, refresh, solve};
-use embedding::{Layout, Point3, SplineSettings, Stencil};
+use embedding::{Layout, Point3, SplineSettings, Stencil, Vector3};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -29,11 +29,11 @@ fn a_drag_reaches_its_target_and_pins_stay() {
         let atlas = Atlas::new(genus).unwrap();
         let layout = Layout::new(&atlas, SplineSettings::default()).unwrap();
         let mut control = wavy(&layout);
-        let size = control.iter().map(|c| c.norm()).fold(0.0, f64::max);
+        let size = control.iter().map(|c| c.coords.norm()).fold(0.0, f64::max);
         let dragged = p(1, 0.1, -0.05);
         let pins = [p(0, 0.2, 0.1), p(1, -0.2, 0.15), p(0, -0.1, -0.3)];
         let before: Vec<Point3> = pins.iter().map(|&q| layout.eval(&control, q).pos).collect();
-        let target = layout.eval(&control, dragged).pos + Point3::new(0.3, -0.2, 0.25);
+        let target = layout.eval(&control, dragged).pos + Vector3::new(0.3, -0.2, 0.25);
         let mut constraints = vec![Constraint {
             point: dragged,
             target,
@@ -69,7 +69,7 @@ fn the_change_is_the_least_norm_one() {
         .enumerate()
         .map(|(i, &q)| Constraint {
             point: q,
-            target: layout.eval(&control, q).pos + Point3::new(0.1 * i as f64, 0.2, -0.1),
+            target: layout.eval(&control, q).pos + Vector3::new(0.1 * i as f64, 0.2, -0.1),
         })
         .collect();
     let edit = solve(&layout, &control, &constraints).unwrap();
@@ -92,7 +92,7 @@ fn the_change_is_the_least_norm_one() {
     let mut ours = DMatrix::<f64>::zeros(n, 3);
     for (&c, delta) in edit.controls.iter().zip(&edit.deltas) {
         for a in 0..3 {
-            ours[(c as usize, a)] = delta[a];
+            ours[(c.index(), a)] = delta[a];
         }
     }
     assert!((ours - best).norm() < 1e-10);
@@ -106,8 +106,8 @@ fn conflicting_constraints_compromise_instead_of_failing() {
     let q = p(0, 0.1, 0.1);
     let here = layout.eval(&control, q).pos;
     let (a, b) = (
-        here + Point3::new(1.0, 0.0, 0.0),
-        here - Point3::new(1.0, 0.0, 0.0),
+        here + Vector3::new(1.0, 0.0, 0.0),
+        here - Vector3::new(1.0, 0.0, 0.0),
     );
     let edit = solve(
         &layout,
@@ -165,12 +165,12 @@ fn refreshing_after_an_edit_equals_full_re_evaluation() {
         let mut control = wavy(&layout);
         let stencil = Stencil::build(&layout, &t.vertices);
         let index = stencil.column_index(layout.control_count());
-        let mut positions = vec![Point3::zeros(); stencil.rows()];
+        let mut positions = vec![Point3::origin(); stencil.rows()];
         stencil.positions(&control, &mut positions);
         let mut scratch = RefreshScratch::default();
         for (step, k) in [123usize, 900, 555].into_iter().enumerate() {
             let q = t.vertices[k];
-            let target = layout.eval(&control, q).pos + Point3::new(0.0, 0.5, 0.1 * step as f64);
+            let target = layout.eval(&control, q).pos + Vector3::new(0.0, 0.5, 0.1 * step as f64);
             let edit = solve(&layout, &control, &[Constraint { point: q, target }]).unwrap();
             edit.apply(&mut control);
             refresh(
@@ -181,7 +181,7 @@ fn refreshing_after_an_edit_equals_full_re_evaluation() {
                 &mut positions,
                 &mut scratch,
             );
-            let mut full = vec![Point3::zeros(); stencil.rows()];
+            let mut full = vec![Point3::origin(); stencil.rows()];
             stencil.positions(&control, &mut full);
             let worst = positions
                 .iter()

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use charts::{Atlas, ChartId, ChartPoint};
 use embedding::bspline::UniformBasis;
-use embedding::{Layout, Model, Point3, SplineSettings, Stencil};
+use embedding::{Layout, Model, Point3, SplineSettings, Stencil, Vector3};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use proptest::prelude::*;
@@ -256,6 +256,7 @@ fn analytic_derivatives_agree_with_finite_differences() {
 
 /// max_n |D_j(t_{n+1}) − D_j(t_n)| / h for the j-th finite-difference derivative along a path.
 fn variation(f: &impl Fn(f64) -> Point3, j: usize, t0: f64, t1: f64, h: f64) -> f64 {
+    let f = |t: f64| f(t).coords;
     let d = |t: f64| match j {
         1 => (f(t + h) - f(t - h)) / (2.0 * h),
         2 => (f(t + h) - 2.0 * f(t) + f(t - h)) / (h * h),
@@ -264,7 +265,7 @@ fn variation(f: &impl Fn(f64) -> Point3, j: usize, t0: f64, t1: f64, h: f64) -> 
         }
     };
     let n = ((t1 - t0) / h) as usize;
-    let values: Vec<Point3> = (0..=n).map(|i| d(t0 + i as f64 * h)).collect();
+    let values: Vec<Vector3> = (0..=n).map(|i| d(t0 + i as f64 * h)).collect();
     values
         .windows(2)
         .map(|w| (w[1] - w[0]).norm())
@@ -409,9 +410,12 @@ fn stencils_equal_direct_evaluation_and_update_in_part() {
         let mut control = noisy_controls(&layout, 3);
         let t = atlas.tessellate(4, 3).unwrap();
         let stencil = Stencil::build(&layout, &t.vertices);
-        let mut pos = vec![Point3::zeros(); t.vertices.len()];
+        let mut pos = vec![Point3::origin(); t.vertices.len()];
         stencil.positions(&control, &mut pos);
-        let (mut du, mut dv) = (pos.clone(), pos.clone());
+        let (mut du, mut dv) = (
+            vec![Vector3::zeros(); pos.len()],
+            vec![Vector3::zeros(); pos.len()],
+        );
         stencil.derivatives(&control, &mut du, &mut dv);
         for (i, &v) in t.vertices.iter().enumerate() {
             let s = layout.eval(&control, v);
@@ -424,11 +428,11 @@ fn stencils_equal_direct_evaluation_and_update_in_part() {
             .into_iter()
             .enumerate()
         {
-            let delta = Point3::new(0.1, -0.2 * n as f64, 0.05);
+            let delta = Vector3::new(0.1, -0.2 * n as f64, 0.05);
             control[c] += delta;
             stencil.update(&index, c, delta, &mut pos);
         }
-        let mut full = vec![Point3::zeros(); t.vertices.len()];
+        let mut full = vec![Point3::origin(); t.vertices.len()];
         stencil.positions(&control, &mut full);
         let worst = pos
             .iter()

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use charts::{Atlas, ChartPoint};
 use embedding::edit::{Constraint, RefreshScratch, refresh, solve};
-use embedding::{Layout, Point3, SplineSettings, Stencil};
+use embedding::{Layout, Point3, SplineSettings, Stencil, Vector3};
 use serde::Serialize;
 
 use super::{GenusArg, spinner, write_stdout};
@@ -168,7 +168,7 @@ pub fn measure(
     let secs = best_of(2, || stencil = Stencil::build(&layout, &pts));
     add("stencil_build", pts.len() as f64 / secs, "vertices", None);
     progress("re-embedding");
-    let mut out = vec![Point3::zeros(); stencil.rows()];
+    let mut out = vec![Point3::origin(); stencil.rows()];
     let secs = best_of(5, || stencil.positions(black_box(&control), &mut out));
     let bytes = 8.0 + 12.0 * stencil.nonzeros() as f64 / stencil.rows() as f64 + 24.0;
     add("reembed", pts.len() as f64 / secs, "vertices", Some(bytes));
@@ -179,7 +179,7 @@ pub fn measure(
     let events = 20;
     let secs = best_of(1, || {
         for k in 0..events {
-            let target = out[pts.len() / 3] + Point3::new(1e-3 * k as f64, 0.0, 0.0);
+            let target = out[pts.len() / 3] + Vector3::new(1e-3 * k as f64, 0.0, 0.0);
             if let Ok(edit) = solve(&layout, &control, &[Constraint { point: q, target }]) {
                 edit.apply(&mut control);
                 refresh(&stencil, &index, &edit, &control, &mut out, &mut scratch);

@@ -4,7 +4,7 @@
 //! Pixels: (0, 0) is the top left corner of the viewport, x to the right, y down, in physical pixels
 //! (egui points times pixels per point); a pixel's centre is at +0.5.
 
-use embedding::Point3;
+use embedding::{Point3, Vector3};
 use glam::{DMat4, DVec2, DVec3, DVec4};
 
 use crate::render::camera::{frame_uniforms, key_light};
@@ -22,7 +22,7 @@ pub const DEFAULT_DISTANCE: f64 = View::DEFAULT.distance;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     pub origin: Point3,
-    pub direction: Point3,
+    pub direction: Vector3,
 }
 
 impl Ray {
@@ -141,7 +141,7 @@ impl OrbitCamera {
         let direction = (unproject(1.0) - origin).normalize();
         Ray {
             origin: to_point(origin),
-            direction: to_point(direction),
+            direction: to_vector(direction),
         }
     }
 
@@ -161,7 +161,7 @@ impl OrbitCamera {
     /// drag that started at `anchor` should reach.
     pub fn on_view_plane(&self, pixel: [f64; 2], size: [f64; 2], anchor: Point3) -> Point3 {
         let ray = self.ray(pixel, size);
-        let normal = to_point(self.direction());
+        let normal = to_vector(self.direction());
         let denominator = ray.direction.dot(&normal);
         if denominator.abs() < 1e-12 {
             return anchor;
@@ -207,12 +207,19 @@ impl OrbitCamera {
     }
 }
 
+/// A position in glam's terms (the camera's maths is glam's; the surface's is nalgebra's).
 pub fn to_glam(p: Point3) -> DVec3 {
     DVec3::new(p.x, p.y, p.z)
 }
 
+/// A glam position as a surface-space position.
 pub fn to_point(v: DVec3) -> Point3 {
     Point3::new(v.x, v.y, v.z)
+}
+
+/// A glam direction as a surface-space vector.
+pub fn to_vector(v: DVec3) -> Vector3 {
+    Vector3::new(v.x, v.y, v.z)
 }
 
 #[cfg(test)]

@@ -24,7 +24,7 @@
 
 use charts::ChartPoint;
 use embedding::edit::{Constraint, solve};
-use embedding::{ControlId, EmbeddingError, Layout, Point3, Surface};
+use embedding::{ControlId, EmbeddingError, Layout, Point3, Surface, Vector3};
 
 use bytemuck::{Pod, Zeroable};
 
@@ -53,9 +53,9 @@ pub struct DragPlan {
     /// The control points when the drag began.
     pub start_control: Vec<Point3>,
     /// Influence: control point and falloff weight.
-    soft: Vec<(u32, f64)>,
+    soft: Vec<(ControlId, f64)>,
     /// Every control point an event may move (sorted), and how: ΔP_c = beta_c Δ.
-    pub touched: Vec<u32>,
+    pub touched: Vec<ControlId>,
     beta: Vec<f64>,
     /// The vertices those control points reach (sorted), and how they move.
     pub rows: Vec<u32>,
@@ -63,7 +63,7 @@ pub struct DragPlan {
     /// Names this plan (the GPU uploads a plan's rows once).
     pub id: u64,
     /// The displacement of the last event.
-    pub displacement: Point3,
+    pub displacement: Vector3,
     /// The least-squares residual of the last solve (0 unless constraints conflict).
     pub residual: f64,
 }
@@ -81,13 +81,13 @@ impl DragPlan {
         let layout = &surface.layout();
         let control = surface.control_points();
         let start_position = layout.eval(control, point).pos;
-        let soft: Vec<(u32, f64)> = if radius > 0.0 {
+        let soft: Vec<(ControlId, f64)> = if radius > 0.0 {
             control
                 .iter()
                 .enumerate()
                 .filter_map(|(c, q)| {
                     let s = (q - start_position).norm() / radius;
-                    (s < 1.0).then(|| (c as u32, falloff(s)))
+                    (s < 1.0).then(|| (ControlId(c as u32), falloff(s)))
                 })
                 .collect()
         } else {
@@ -100,7 +100,7 @@ impl DragPlan {
         for c in row
             .iter()
             .map(|w| w.control)
-            .chain(soft.iter().map(|s| s.0))
+            .chain(soft.iter().map(|s| s.0.0))
         {
             moving[c as usize] = true;
         }
@@ -148,12 +148,13 @@ impl DragPlan {
             rows: Vec::new(),
             moves: Vec::new(),
             id: NEXT_PLAN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
-            displacement: Point3::zeros(),
+            displacement: Vector3::zeros(),
             residual: 0.0,
         };
         // β by linearity: the change for a unit displacement along x.
-        let (moved, _) = plan.solve(layout, Point3::x())?;
-        let mut touched: Vec<(u32, f64)> = moved.iter().map(|(c, delta)| (*c, delta.x)).collect();
+        let (moved, _) = plan.solve(layout, Vector3::x())?;
+        let mut touched: Vec<(ControlId, f64)> =
+            moved.iter().map(|(c, delta)| (*c, delta.x)).collect();
         touched.sort_unstable_by_key(|t| t.0);
         plan.touched = touched.iter().map(|t| t.0).collect();
         plan.beta = touched.iter().map(|t| t.1).collect();
@@ -162,7 +163,7 @@ impl DragPlan {
         let n = mesh.vertex_count();
         let mut marks = vec![0u64; n.div_ceil(64)];
         for &c in &plan.touched {
-            for &r in mesh.stencil().rows_of(mesh.columns(), c as usize) {
+            for &r in mesh.stencil().rows_of(mesh.columns(), c.index()) {
                 marks[r as usize / 64] |= 1 << (r % 64);
             }
         }
@@ -179,7 +180,7 @@ impl DragPlan {
         // by control point.
         let mut beta = vec![0.0f64; control.len()];
         for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
-            beta[c as usize] = b;
+            beta[c.index()] = b;
         }
         let (stencil, positions, tangents) = (mesh.stencil(), mesh.positions(), mesh.tangents());
         plan.moves = vec![DragRow::default(); plan.rows.len()];
@@ -215,13 +216,13 @@ impl DragPlan {
     fn solve(
         &self,
         layout: &Layout,
-        delta: Point3,
-    ) -> Result<(Vec<(u32, Point3)>, f64), EmbeddingError> {
+        delta: Vector3,
+    ) -> Result<(Vec<(ControlId, Vector3)>, f64), EmbeddingError> {
         let mut start = std::borrow::Cow::Borrowed(&self.start_control);
         if !self.soft.is_empty() {
             let shifted = start.to_mut();
             for &(c, f) in &self.soft {
-                shifted[c as usize] += delta * f;
+                shifted[c.index()] += delta * f;
             }
         }
         let mut constraints = Vec::with_capacity(1 + self.pins.len());
@@ -231,7 +232,7 @@ impl DragPlan {
         });
         constraints.extend_from_slice(&self.pins);
         let edit = solve(layout, &start, &constraints)?;
-        let mut moved: Vec<(u32, Point3)> =
+        let mut moved: Vec<(ControlId, Vector3)> =
             self.soft.iter().map(|&(c, f)| (c, delta * f)).collect();
         moved.extend(
             edit.controls
@@ -241,7 +242,7 @@ impl DragPlan {
         );
         // Merge a control point that is both soft and corrected.
         moved.sort_unstable_by_key(|m| m.0);
-        let mut merged: Vec<(u32, Point3)> = Vec::with_capacity(moved.len());
+        let mut merged: Vec<(ControlId, Vector3)> = Vec::with_capacity(moved.len());
         for (c, d) in moved {
             match merged.last_mut() {
                 Some(last) if last.0 == c => last.1 += d,
@@ -264,10 +265,10 @@ impl DragPlan {
         let mut updates: Vec<(ControlId, Point3)> = self
             .touched
             .iter()
-            .map(|&c| (ControlId(c), self.start_control[c as usize]))
+            .map(|&c| (c, self.start_control[c.index()]))
             .collect();
         for (c, d) in moved {
-            updates.push((ControlId(c), self.start_control[c as usize] + d));
+            updates.push((c, self.start_control[c.index()] + d));
         }
         surface.set_control_points_at(updates.iter().copied())?;
         self.displacement = delta;
@@ -278,7 +279,7 @@ impl DragPlan {
     /// The vertices' positions and normals for displacement `delta`, written into a vertex array on
     /// the CPU: what the vertex shader does (sorted rows, so the array splits into disjoint pieces,
     /// one per thread).
-    pub fn move_vertices(&self, delta: Point3, vertices: &mut [ViewVertex]) {
+    pub fn move_vertices(&self, delta: Vector3, vertices: &mut [ViewVertex]) {
         let d = [delta.x as f32, delta.y as f32, delta.z as f32];
         let work = |first: usize, rows: &[u32], out: &mut [ViewVertex], offset: usize| {
             for (k, &r) in (first..).zip(rows) {

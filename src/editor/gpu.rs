@@ -6,7 +6,7 @@
 //! tests. The uniforms, the pipeline, the targets and the read-back are the offscreen renderer's
 //! ([`crate::render::gpu`]).
 
-use embedding::Point3;
+use embedding::Vector3;
 
 use super::drag::DragRow;
 use super::mesh::LiveMesh;
@@ -114,7 +114,7 @@ impl ViewportRenderer {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         mesh: &mut LiveMesh,
-        drag: Option<(u64, &[DragRow], Point3)>,
+        drag: Option<(u64, &[DragRow], Vector3)>,
     ) -> bool {
         let mut new_group = false;
         if let Some((id, rows, _)) = drag

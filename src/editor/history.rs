@@ -1,14 +1,14 @@
 //! Undo and redo. A drag stores only the control points it moved, before and after (exact copies, so
 //! undo restores them bit for bit); a change of spline settings stores both whole models.
 
-use embedding::{Point3, SplineSettings};
+use embedding::{ControlId, Point3, SplineSettings};
 
 /// One undoable change.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Change {
     /// Some control points moved.
     Controls {
-        indices: Vec<u32>,
+        indices: Vec<ControlId>,
         before: Vec<Point3>,
         after: Vec<Point3>,
     },

@@ -10,7 +10,10 @@ use std::ops::Range;
 
 use bytemuck::{Pod, Zeroable};
 use charts::Tessellation;
-use embedding::{ColumnIndex, Point3, Sample, Stencil, Surface, Wants, evaluate_rows};
+use embedding::{
+    ColumnIndex, ControlId, Point3, Sample, Stencil, Surface, Vector3, Wants, bounding_box,
+    evaluate_rows,
+};
 
 use super::camera::Ray;
 use super::pick::{Bvh, Hit};
@@ -90,7 +93,7 @@ pub struct LiveMesh {
     stencil: Stencil,
     columns: ColumnIndex,
     positions: Vec<Point3>,
-    tangents: Vec<[Point3; 2]>,
+    tangents: Vec<[Vector3; 2]>,
     vertices: Vec<ViewVertex>,
     indices: Vec<u32>,
     dirty: Dirty,
@@ -122,8 +125,8 @@ impl LiveMesh {
             tessellation,
             stencil,
             columns,
-            positions: vec![Point3::zeros(); n],
-            tangents: vec![[Point3::zeros(); 2]; n],
+            positions: vec![Point3::origin(); n],
+            tangents: vec![[Vector3::zeros(); 2]; n],
             vertices: vec![ViewVertex::default(); n],
             indices,
             dirty: Dirty {
@@ -154,7 +157,7 @@ impl LiveMesh {
     pub fn positions(&self) -> &[Point3] {
         &self.positions
     }
-    pub fn tangents(&self) -> &[[Point3; 2]] {
+    pub fn tangents(&self) -> &[[Vector3; 2]] {
         &self.tangents
     }
     pub fn vertices(&self) -> &[ViewVertex] {
@@ -241,8 +244,8 @@ impl LiveMesh {
 
     /// The centre of the bounding box and the largest distance from it.
     pub fn bounding_sphere(&self) -> (Point3, f64) {
-        let (lo, hi) = bounds(&self.positions);
-        let centre = (lo + hi) / 2.0;
+        let (lo, hi) = bounding_box(&self.positions);
+        let centre = lo + (hi - lo) / 2.0;
         let radius = self
             .positions
             .iter()
@@ -253,7 +256,7 @@ impl LiveMesh {
 
     /// The bounding box's diagonal: the model's size.
     pub fn size(&self) -> f64 {
-        let (lo, hi) = bounds(&self.positions);
+        let (lo, hi) = bounding_box(&self.positions);
         (hi - lo).norm()
     }
 
@@ -267,10 +270,10 @@ impl LiveMesh {
     }
 
     /// The rows any of `controls` touches, in increasing order.
-    pub fn rows_of_controls(&mut self, controls: &[u32]) -> Vec<u32> {
+    pub fn rows_of_controls(&mut self, controls: &[ControlId]) -> Vec<u32> {
         let mut rows = Vec::new();
         for &c in controls {
-            for &r in self.stencil.rows_of(&self.columns, c as usize) {
+            for &r in self.stencil.rows_of(&self.columns, c.index()) {
                 let (w, bit) = (r as usize / 64, 1u64 << (r % 64));
                 if self.marks[w] & bit == 0 {
                     self.marks[w] |= bit;
@@ -287,7 +290,7 @@ impl LiveMesh {
 
     /// After `controls` changed: recomputes exactly the rows they touch (and their colours in the
     /// curvature style), marks them for upload and the picking boxes for refitting.
-    pub fn controls_changed(&mut self, surface: &Surface, controls: &[u32]) {
+    pub fn controls_changed(&mut self, surface: &Surface, controls: &[ControlId]) {
         let rows = self.rows_of_controls(controls);
         self.rows_changed(surface, &rows);
     }
@@ -351,14 +354,4 @@ impl LiveMesh {
     pub fn curvature_range(&self) -> Option<f64> {
         self.curvature_range
     }
-}
-
-fn bounds(points: &[Point3]) -> (Point3, Point3) {
-    points.iter().fold(
-        (
-            Point3::repeat(f64::INFINITY),
-            Point3::repeat(f64::NEG_INFINITY),
-        ),
-        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-    )
 }

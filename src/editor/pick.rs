@@ -64,7 +64,7 @@ impl Bvh {
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|v| positions[v as usize]);
-                let m = (a + b + c) / 3.0;
+                let m = (a.coords + b.coords + c.coords) / 3.0;
                 [m.x, m.y, m.z]
             })
             .collect();

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
 use embedding::fit::{FitSettings, vertex_areas};
-use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surface};
+use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surface, Vector3};
 
 use super::camera::{OrbitCamera, to_point};
 use super::drag::{DragPlan, DragRow};
@@ -402,7 +402,7 @@ impl EditorState {
 
     /// The drag as the GPU shows it: the plan's id, the vertices it moves and how, and the
     /// displacement of the last event.
-    pub fn drag_display(&self) -> Option<(u64, &[DragRow], Point3)> {
+    pub fn drag_display(&self) -> Option<(u64, &[DragRow], Vector3)> {
         self.drag
             .as_ref()
             .map(|d| (d.plan.id, &d.plan.moves[..], d.plan.displacement))
@@ -411,7 +411,7 @@ impl EditorState {
     /// The live mesh and the drag as the GPU shows it, together (for uploading both).
     pub fn with_display<R>(
         &mut self,
-        f: impl FnOnce(&mut LiveMesh, Option<(u64, &[DragRow], Point3)>) -> R,
+        f: impl FnOnce(&mut LiveMesh, Option<(u64, &[DragRow], Vector3)>) -> R,
     ) -> R {
         let drag = self
             .drag
@@ -426,11 +426,11 @@ impl EditorState {
             return;
         };
         let plan = drag.plan;
-        let moved: Vec<u32> = plan
+        let moved: Vec<ControlId> = plan
             .touched
             .iter()
             .copied()
-            .filter(|&c| self.control()[c as usize] != plan.start_control[c as usize])
+            .filter(|&c| self.control()[c.index()] != plan.start_control[c.index()])
             .collect();
         self.mesh.rows_changed(&self.surface, &plan.rows);
         self.last_drag = Some(DragStats {
@@ -455,9 +455,9 @@ impl EditorState {
             Change::Controls {
                 before: moved
                     .iter()
-                    .map(|&c| plan.start_control[c as usize])
+                    .map(|&c| plan.start_control[c.index()])
                     .collect(),
-                after: moved.iter().map(|&c| self.control()[c as usize]).collect(),
+                after: moved.iter().map(|&c| self.control()[c.index()]).collect(),
                 indices: moved,
             },
         );
@@ -469,11 +469,7 @@ impl EditorState {
             return;
         };
         let start = &drag.plan.start_control;
-        let restored = drag
-            .plan
-            .touched
-            .iter()
-            .map(|&c| (ControlId(c), start[c as usize]));
+        let restored = drag.plan.touched.iter().map(|&c| (c, start[c.index()]));
         // The starting control points were valid, so restoring them cannot fail.
         if self.surface.set_control_points_at(restored).is_ok() {
             self.mesh.rows_changed(&self.surface, &drag.plan.rows);
@@ -523,7 +519,7 @@ impl EditorState {
                 after,
             } => {
                 let values = if forward { after } else { before };
-                let updates = indices.iter().zip(values).map(|(&c, &v)| (ControlId(c), v));
+                let updates = indices.iter().copied().zip(values.iter().copied());
                 self.surface.set_control_points_at(updates)?;
                 self.mesh.controls_changed(&self.surface, indices);
             }
@@ -619,7 +615,7 @@ pub fn refit(
     let t = (2 * settings.grid.max(surface.settings().grid)).clamp(16, 96) as u32;
     let tessellation = atlas.tessellate(t, t)?;
     let stencil = embedding::Stencil::build(&surface.layout(), &tessellation.vertices);
-    let mut targets = vec![Point3::zeros(); stencil.rows()];
+    let mut targets = vec![Point3::origin(); stencil.rows()];
     stencil.positions(surface.control_points(), &mut targets);
     let weights = vertex_areas(&targets, &tessellation.triangles);
     let fitted = embedding::fit::fit(
@@ -630,7 +626,7 @@ pub fn refit(
         FitSettings::default(),
     )?;
     let check = embedding::Stencil::build(&new, &tessellation.vertices);
-    let mut now = vec![Point3::zeros(); check.rows()];
+    let mut now = vec![Point3::origin(); check.rows()];
     check.positions(&fitted, &mut now);
     let worst = now
         .iter()

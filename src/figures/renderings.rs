@@ -7,7 +7,7 @@
 use charts::{ChartPoint, ModelPoint};
 use embedding::edit::{Constraint, solve};
 use embedding::fit::{FitSettings, InitialFit, initial_model};
-use embedding::{Point3, SplineSettings, Surface};
+use embedding::{Point3, SplineSettings, Surface, Vector3, bounding_box};
 
 use super::geometry::side_points;
 use super::{Figure, FiguresError, GENUS, palette};
@@ -156,7 +156,7 @@ pub fn loops(surface: &Surface) -> Result<Vec<Curve>, embedding::EmbeddingError>
 /// An edit of the genus-2 surface: mesh vertices and how far each moves, and vertices that stay.
 struct Scripted {
     name: &'static str,
-    moved: Vec<(usize, Point3)>,
+    moved: Vec<(usize, Vector3)>,
     pinned: Vec<usize>,
 }
 
@@ -165,12 +165,12 @@ struct Scripted {
 /// points on the far side are pinned.
 fn pull_rim(fit: &InitialFit) -> Scripted {
     let p = &fit.mesh.positions;
-    let (lo, hi) = bounds(p);
+    let (lo, hi) = bounding_box(p);
     let centre = Point3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.0);
     let reach = hi.x - centre.x;
     let at = |r: f64, degrees: f64, z: f64| {
         let a = degrees.to_radians();
-        centre + Point3::new(r * a.cos(), r * a.sin(), z)
+        centre + Vector3::new(r * a.cos(), r * a.sin(), z)
     };
     let amount = 0.07 * (hi.x - lo.x);
     let mut moved = Vec::new();
@@ -179,7 +179,7 @@ fn pull_rim(fit: &InitialFit) -> Scripted {
         let weight = (degrees / 40.0 * std::f64::consts::FRAC_PI_2).cos();
         moved.push((
             nearest_vertex(p, q),
-            Point3::new(a.cos(), a.sin(), 0.0) * (amount * weight),
+            Vector3::new(a.cos(), a.sin(), 0.0) * (amount * weight),
         ));
     };
     for degrees in [-30.0, -15.0, 0.0, 15.0, 30.0] {
@@ -201,7 +201,7 @@ fn pull_rim(fit: &InitialFit) -> Scripted {
 /// and four around the other holes are pinned.
 fn push_hole(fit: &InitialFit) -> Scripted {
     let p = &fit.mesh.positions;
-    let (lo, hi) = bounds(p);
+    let (lo, hi) = bounding_box(p);
     let half = 0.5 * (hi.z - lo.z);
     // The holes' centres: the loops a_k run around them, so their centroids lie near.
     let centres: Vec<Point3> = fit
@@ -210,7 +210,9 @@ fn push_hole(fit: &InitialFit) -> Scripted {
         .iter()
         .step_by(2)
         .map(|l| {
-            let sum = l.iter().fold(Point3::zeros(), |s, &v| s + p[v as usize]);
+            let sum = l
+                .iter()
+                .fold(Vector3::zeros(), |s, &v| s + p[v as usize].coords);
             let c = sum / l.len() as f64;
             Point3::new(c.x, c.y, 0.0)
         })
@@ -228,13 +230,13 @@ fn push_hole(fit: &InitialFit) -> Scripted {
         (0..count)
             .map(|j| {
                 let a = std::f64::consts::TAU * j as f64 / count as f64;
-                nearest_vertex(p, c + Point3::new(r * a.cos(), r * a.sin(), z))
+                nearest_vertex(p, c + Vector3::new(r * a.cos(), r * a.sin(), z))
             })
             .collect()
     };
     let moved = ring(centres[k], half, 8)
         .into_iter()
-        .map(|i| (i, Point3::new(0.0, 0.0, 0.6 * half)))
+        .map(|i| (i, Vector3::new(0.0, 0.0, 0.6 * half)))
         .collect();
     let mut pinned = ring(centres[k], -half, 4);
     for (j, &c) in centres.iter().enumerate() {
@@ -254,16 +256,6 @@ fn nearest_vertex(p: &[Point3], q: Point3) -> usize {
     (0..p.len())
         .min_by(|&a, &b| (p[a] - q).norm().total_cmp(&(p[b] - q).norm()))
         .unwrap_or(0)
-}
-
-fn bounds(p: &[Point3]) -> (Point3, Point3) {
-    p.iter().fold(
-        (
-            Point3::repeat(f64::INFINITY),
-            Point3::repeat(f64::NEG_INFINITY),
-        ),
-        |(lo, hi), q| (lo.inf(q), hi.sup(q)),
-    )
 }
 
 /// The edited model: the least-norm change moving the scripted points by their offsets (from where

@@ -202,7 +202,7 @@ fn too_many_triangles_are_refused_before_any_work() {
     let count = embedding::Layout::new(&atlas, SplineSettings::default())
         .unwrap()
         .control_count();
-    let control = vec![embedding::Point3::zeros(); count];
+    let control = vec![embedding::Point3::origin(); count];
     let model = embedding::Surface::new(atlas, SplineSettings::default(), control).unwrap();
     let path = dir.path().join("big.json");
     ntori::io::model_file::save(&path, &model).unwrap();

@@ -6,7 +6,7 @@
 use std::io::Cursor;
 use std::sync::OnceLock;
 
-use embedding::{Model, Surface};
+use embedding::{Model, Point3, Surface, Vector3};
 use mesh::HalfEdgeMesh;
 use ntori::io::export::{
     self, Encoding, ExportError, Format, MAX_RESOLUTION, SurfaceMesh, surface_mesh,
@@ -37,28 +37,19 @@ fn write(mesh: &SurfaceMesh, format: Format, encoding: Encoding) -> Vec<u8> {
     std::fs::read(&path).unwrap()
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+/// A position or a direction as a file stores it (f32), widened.
+fn point(p: [f32; 3]) -> Point3 {
+    Point3::from(p.map(f64::from))
 }
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn widen(p: [f32; 3]) -> [f64; 3] {
-    p.map(f64::from)
+fn vector(v: [f32; 3]) -> Vector3 {
+    Vector3::from(v.map(f64::from))
 }
 
 /// A mesh as read back from a file.
 #[derive(Default)]
 struct ReadBack {
-    positions: Vec<[f64; 3]>,
-    normals: Option<Vec<[f64; 3]>>,
+    positions: Vec<Point3>,
+    normals: Option<Vec<Vector3>>,
     triangles: Vec<[u32; 3]>,
 }
 
@@ -108,8 +99,8 @@ fn check(read: &ReadBack, reference: &SurfaceMesh, what: &str) -> Vec<usize> {
         .triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| read.positions[i as usize]);
-            dot(a, cross(b, c))
+            let [a, b, c] = t.map(|i| read.positions[i as usize].coords);
+            a.dot(&b.cross(&c))
         })
         .sum::<f64>()
         / 6.0;
@@ -119,33 +110,32 @@ fn check(read: &ReadBack, reference: &SurfaceMesh, what: &str) -> Vec<usize> {
     let scale = reference
         .positions
         .iter()
-        .flatten()
+        .flat_map(|p| p.iter())
         .fold(1.0f64, |m, x| m.max(x.abs()));
     let tolerance = 2.0 * f64::from(f32::EPSILON) * scale;
     for (i, &got) in read.positions.iter().enumerate() {
         let want = reference.positions[map[i]];
-        let d = sub(got, want).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let d = (got - want).amax();
         assert!(d <= tolerance, "{what}: vertex {i}: {got:?} vs {want:?}");
     }
 
     // Unit normals, the surface mesh's, agreeing in sign with the area-weighted face normals.
     if let Some(normals) = &read.normals {
         assert_eq!(normals.len(), read.positions.len(), "{what}");
-        let mut faces = vec![[0.0; 3]; read.positions.len()];
+        let mut faces = vec![Vector3::zeros(); read.positions.len()];
         for t in &read.triangles {
             let [a, b, c] = t.map(|i| read.positions[i as usize]);
-            let n = cross(sub(b, a), sub(c, a));
+            let n = (b - a).cross(&(c - a));
             for &v in t {
-                let s = &mut faces[v as usize];
-                *s = [s[0] + n[0], s[1] + n[1], s[2] + n[2]];
+                faces[v as usize] += n;
             }
         }
         for (i, (n, f)) in normals.iter().zip(&faces).enumerate() {
-            let length = dot(*n, *n).sqrt();
+            let length = n.norm();
             assert!((length - 1.0).abs() < 1e-6, "{what}: normal {i}: {length}");
-            let d = sub(*n, reference.normals[map[i]]);
-            assert!(dot(d, d).sqrt() < 1e-6, "{what}: normal {i}");
-            let cosine = dot(*n, *f) / dot(*f, *f).sqrt();
+            let d = n - reference.normals[map[i]];
+            assert!(d.norm() < 1e-6, "{what}: normal {i}");
+            let cosine = n.dot(f) / f.norm();
             assert!(
                 cosine > 0.5,
                 "{what}: vertex {i}: normal {n:?} vs faces {f:?}"
@@ -196,14 +186,11 @@ fn obj(bytes: &[u8]) -> (ReadBack, Vec<[f64; 2]>) {
     // v/vt/vn share the index, so each vertex's texture coordinate and normal are its own.
     assert_eq!(m.indices, m.texcoord_indices);
     assert_eq!(m.indices, m.normal_indices);
-    let triples = |v: &[f32]| -> Vec<[f64; 3]> {
-        v.chunks_exact(3)
-            .map(|c| widen([c[0], c[1], c[2]]))
-            .collect()
-    };
+    let triples =
+        |v: &[f32]| -> Vec<[f32; 3]> { v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
     let read = ReadBack {
-        positions: triples(&m.positions),
-        normals: Some(triples(&m.normals)),
+        positions: triples(&m.positions).into_iter().map(point).collect(),
+        normals: Some(triples(&m.normals).into_iter().map(vector).collect()),
         triangles: m
             .indices
             .chunks_exact(3)
@@ -253,12 +240,12 @@ fn ply_reads_back_with_the_ply_parser_in_both_encodings() {
             let read = ReadBack {
                 positions: vertices
                     .iter()
-                    .map(|e| [float(e, "x"), float(e, "y"), float(e, "z")])
+                    .map(|e| Point3::new(float(e, "x"), float(e, "y"), float(e, "z")))
                     .collect(),
                 normals: Some(
                     vertices
                         .iter()
-                        .map(|e| [float(e, "nx"), float(e, "ny"), float(e, "nz")])
+                        .map(|e| Vector3::new(float(e, "nx"), float(e, "ny"), float(e, "nz")))
                         .collect(),
                 ),
                 triangles: ply.payload["face"]
@@ -303,7 +290,7 @@ fn stl_reads_back_with_stl_io_in_both_encodings() {
             // stl_io merges corners at identical positions into vertices.
             let stl = stl_io::read_stl(&mut Cursor::new(&bytes)).unwrap();
             let read = ReadBack {
-                positions: stl.vertices.iter().map(|v| widen(v.0)).collect(),
+                positions: stl.vertices.iter().map(|v| point(v.0)).collect(),
                 normals: None,
                 triangles: stl
                     .faces
@@ -314,18 +301,14 @@ fn stl_reads_back_with_stl_io_in_both_encodings() {
             check(&read, mesh, &what);
             // Face normals: unit, outward (as the winding), and on the side of the analytic normals.
             for (k, f) in stl.faces.iter().enumerate() {
-                let n = widen(f.normal.0);
-                assert!((dot(n, n).sqrt() - 1.0).abs() < 1e-5, "{what}: facet {k}");
+                let n = vector(f.normal.0);
+                assert!((n.norm() - 1.0).abs() < 1e-5, "{what}: facet {k}");
                 let [a, b, c] = read.triangles[k].map(|i| read.positions[i as usize]);
-                assert!(
-                    dot(n, cross(sub(b, a), sub(c, a))) > 0.0,
-                    "{what}: facet {k}"
-                );
-                let analytic = mesh.triangles[k].iter().fold([0.0; 3], |s, &v| {
-                    let m = mesh.normals[v as usize];
-                    [s[0] + m[0], s[1] + m[1], s[2] + m[2]]
-                });
-                assert!(dot(n, analytic) > 0.0, "{what}: facet {k}");
+                assert!(n.dot(&(b - a).cross(&(c - a))) > 0.0, "{what}: facet {k}");
+                let analytic = mesh.triangles[k]
+                    .iter()
+                    .fold(Vector3::zeros(), |s, &v| s + mesh.normals[v as usize]);
+                assert!(n.dot(&analytic) > 0.0, "{what}: facet {k}");
             }
         }
     }
@@ -361,9 +344,9 @@ fn glb_reads_back_with_gltf_and_is_well_formed() {
         let p = &primitives[0];
         assert_eq!(p.mode(), gltf::mesh::Mode::Triangles);
         let reader = p.reader(|_| Some(blob));
-        let positions: Vec<[f64; 3]> = reader.read_positions().unwrap().map(widen).collect();
+        let positions: Vec<Point3> = reader.read_positions().unwrap().map(point).collect();
         let read = ReadBack {
-            normals: Some(reader.read_normals().unwrap().map(widen).collect()),
+            normals: Some(reader.read_normals().unwrap().map(vector).collect()),
             triangles: reader
                 .read_indices()
                 .unwrap()
@@ -423,7 +406,9 @@ fn parse_off(text: &str) -> ReadBack {
     assert_eq!(tokens.next(), Some("OFF"));
     let mut number = || tokens.next().unwrap().parse::<f64>().unwrap();
     let (v, f, _edges) = (number() as usize, number() as usize, number());
-    let positions = (0..v).map(|_| [number(), number(), number()]).collect();
+    let positions = (0..v)
+        .map(|_| Point3::new(number(), number(), number()))
+        .collect();
     let triangles = (0..f)
         .map(|_| {
             assert_eq!(number(), 3.0);
@@ -546,7 +531,7 @@ fn formats_come_from_extensions() {
 fn model_files_round_trip_and_report_what_is_wrong() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.json");
-    model_file::save(&path, &models()[1]).unwrap();
+    model_file::save(&path, models()[1]).unwrap();
     assert_eq!(model_file::load(&path).unwrap(), *models()[1]);
 
     let text = std::fs::read_to_string(&path).unwrap();
@@ -583,7 +568,7 @@ fn model_files_round_trip_and_report_what_is_wrong() {
 
     // Saving into a directory that does not exist fails and leaves nothing behind.
     let nowhere = dir.path().join("no/such/dir/m.json");
-    assert!(model_file::save(&nowhere, &models()[1]).is_err());
+    assert!(model_file::save(&nowhere, models()[1]).is_err());
     assert!(!nowhere.exists());
 }
 

@@ -53,7 +53,7 @@ fn holed_meshes_are_closed_genus_n_manifolds_with_simple_canonical_loops() {
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-                a.dot(&b.cross(&c)) / 6.0
+                a.coords.dot(&b.coords.cross(&c.coords)) / 6.0
             })
             .sum();
         assert!(volume > 0.0, "genus {genus}: volume {volume}");
@@ -146,11 +146,14 @@ fn the_sphere_is_parameterized_stereographically() {
         let z = atlas.to_model(*point).unwrap().0;
         let back = if point.chart.0 == 0 || z.norm() < 1e6 {
             let d = 1.0 + z.norm_sqr();
-            embedding::Point3::new(2.0 * z.re / d, 2.0 * z.im / d, (1.0 - z.norm_sqr()) / d)
+            embedding::Vector3::new(2.0 * z.re / d, 2.0 * z.im / d, (1.0 - z.norm_sqr()) / d)
         } else {
-            embedding::Point3::new(0.0, 0.0, -1.0)
+            embedding::Vector3::new(0.0, 0.0, -1.0)
         };
-        assert!((back - x / x.norm()).norm() < 1e-9, "{x} → {z}");
+        assert!(
+            (back - x.coords / x.coords.norm()).norm() < 1e-9,
+            "{x} → {z}"
+        );
     }
 }
 
@@ -165,7 +168,7 @@ fn fitted_surfaces_are_close_immersed_embedded_and_satisfy_gauss_bonnet() {
         let surface = |te: u32| {
             let t = atlas.tessellate(te, te).unwrap();
             let stencil = Stencil::build(&layout, &t.vertices);
-            let mut pos = vec![embedding::Point3::zeros(); t.vertices.len()];
+            let mut pos = vec![embedding::Point3::origin(); t.vertices.len()];
             stencil.positions(&control, &mut pos);
             (t, arrays(&pos))
         };

@@ -26,7 +26,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use charts::Tessellation;
-use embedding::{EmbeddingError, Sample, Surface, Wants, evaluate};
+use embedding::{EmbeddingError, Point3, Sample, Surface, Vector3, Wants, evaluate};
 
 use crate::io::atomic::{FileError, write_atomically_with};
 
@@ -53,9 +53,9 @@ pub struct SurfaceMesh {
     pub genus: u32,
     pub te: u32,
     pub tr: u32,
-    pub positions: Vec<[f64; 3]>,
+    pub positions: Vec<Point3>,
     /// Analytic unit normals, outward.
-    pub normals: Vec<[f64; 3]>,
+    pub normals: Vec<Vector3>,
     /// The vertex's coordinates in its home chart, plus ½: within [0, 1]².
     pub uvs: Vec<[f64; 2]>,
     /// The vertex's home chart.
@@ -200,7 +200,9 @@ pub fn surface_mesh(surface: &Surface, te: u32, tr: u32) -> Result<SurfaceMesh, 
     // no surface at all.
     let size = surface.control_net_size();
     let control = surface.control_points();
-    let largest = control.iter().fold(0.0f64, |m, p| m.max(p.abs().max()));
+    let largest = control
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.coords.abs().max()));
     if size.is_nan() || size <= 1e-12 * largest {
         let p = control.first().copied().unwrap_or_default();
         return Err(ExportError::Degenerate {
@@ -232,9 +234,9 @@ pub fn surface_mesh(surface: &Surface, te: u32, tr: u32) -> Result<SurfaceMesh, 
         Wants::default(),
         tiny * tiny,
         &mut |s: &Sample| {
-            mesh.positions.push(s.position.into());
+            mesh.positions.push(s.position);
             mesh.normals
-                .push(s.normal.map_or([f64::NAN; 3], Into::into));
+                .push(s.normal.unwrap_or(Vector3::repeat(f64::NAN)));
             mesh.uvs
                 .push([s.point.coords.re + 0.5, s.point.coords.im + 0.5]);
             mesh.charts.push(s.point.chart.0);
@@ -255,15 +257,15 @@ impl SurfaceMesh {
         if bad.is_empty() {
             return Ok(());
         }
-        let mut sums = vec![[0.0; 3]; self.positions.len()];
+        let mut sums = vec![Vector3::zeros(); self.positions.len()];
         for t in &self.triangles {
             let n = face_normal(&self.positions, t);
             for &v in t {
-                sums[v as usize] = add(sums[v as usize], n);
+                sums[v as usize] += n;
             }
         }
         let mut still = bad.iter().filter_map(|&i| {
-            let n = normalize(sums[i]);
+            let n = sums[i].normalize();
             if n.iter().all(|x| x.is_finite()) {
                 self.normals[i] = n;
                 None
@@ -274,8 +276,13 @@ impl SurfaceMesh {
         match still.next() {
             Some(first) => {
                 let count = 1 + still.count();
-                let [x, y, z] = self.positions[first];
-                Err(ExportError::Degenerate { count, x, y, z })
+                let p = self.positions[first];
+                Err(ExportError::Degenerate {
+                    count,
+                    x: p.x,
+                    y: p.y,
+                    z: p.z,
+                })
             }
             None => Ok(()),
         }
@@ -289,51 +296,27 @@ impl SurfaceMesh {
                 t.swap(1, 2);
             }
             for n in &mut self.normals {
-                *n = n.map(|x| -x);
+                *n = -*n;
             }
         }
     }
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let l = dot(a, a).sqrt();
-    a.map(|x| x / l)
-}
-
 /// Twice the area times the unit normal of a triangle, from its winding.
-fn face_normal(positions: &[[f64; 3]], t: &[u32; 3]) -> [f64; 3] {
+fn face_normal(positions: &[Point3], t: &[u32; 3]) -> Vector3 {
     let [a, b, c] = t.map(|i| positions[i as usize]);
-    cross(sub(b, a), sub(c, a))
+    (b - a).cross(&(c - a))
 }
 
 /// Σ a·(b × c) / 6 over the triangles, about the centroid (so far-off models keep their digits).
-pub fn signed_volume(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> f64 {
+pub fn signed_volume(positions: &[Point3], triangles: &[[u32; 3]]) -> f64 {
     let n = positions.len().max(1) as f64;
-    let centre = positions
-        .iter()
-        .fold([0.0; 3], |s, p| add(s, *p))
-        .map(|x| x / n);
+    let centre = Point3::from(positions.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n);
     triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| sub(positions[i as usize], centre));
-            dot(a, cross(b, c))
+            let [a, b, c] = t.map(|i| positions[i as usize] - centre);
+            a.dot(&b.cross(&c))
         })
         .sum::<f64>()
         / 6.0
@@ -354,10 +337,10 @@ impl SurfaceMesh {
     }
 
     fn position_f32(&self, i: usize) -> [f32; 3] {
-        self.positions[i].map(|x| x as f32)
+        self.positions[i].coords.cast::<f32>().into()
     }
     fn normal_f32(&self, i: usize) -> [f32; 3] {
-        self.normals[i].map(|x| x as f32)
+        self.normals[i].cast::<f32>().into()
     }
 
     /// Triangles whose winding faces against the surface's normals at their corners (the normal
@@ -369,24 +352,23 @@ impl SurfaceMesh {
                 let n = face_normal(&self.positions, &self.triangles[k]);
                 let m = self.triangles[k]
                     .iter()
-                    .fold([0.0; 3], |s, &v| add(s, self.normals[v as usize]));
-                dot(n, m) < 0.0
+                    .fold(Vector3::zeros(), |s, &v| s + self.normals[v as usize]);
+                n.dot(&m) < 0.0
             })
             .count()
     }
 
     /// The unit normal of triangle `t` from its winding (outward), for STL.
-    pub fn face_normal(&self, t: usize) -> [f64; 3] {
-        let n = normalize(face_normal(&self.positions, &self.triangles[t]));
+    pub fn face_normal(&self, t: usize) -> Vector3 {
+        let n = face_normal(&self.positions, &self.triangles[t]).normalize();
         if n.iter().all(|x| x.is_finite()) {
             n
         } else {
             // A sliver with no area: the corners' analytic normals say which way is out.
-            normalize(
-                self.triangles[t]
-                    .iter()
-                    .fold([0.0; 3], |s, &v| add(s, self.normals[v as usize])),
-            )
+            self.triangles[t]
+                .iter()
+                .fold(Vector3::zeros(), |s, &v| s + self.normals[v as usize])
+                .normalize()
         }
     }
 }

@@ -14,7 +14,7 @@ pub fn write_stl(
         Encoding::Ascii => {
             writeln!(out, "solid ntori")?;
             for (k, t) in mesh.triangles.iter().enumerate() {
-                let [nx, ny, nz] = mesh.face_normal(k).map(|x| x as f32);
+                let [nx, ny, nz]: [f32; 3] = mesh.face_normal(k).cast::<f32>().into();
                 writeln!(out, "  facet normal {nx:e} {ny:e} {nz:e}")?;
                 writeln!(out, "    outer loop")?;
                 for &v in t {
@@ -36,7 +36,7 @@ pub fn write_stl(
             out.write_all(&(mesh.triangles.len() as u32).to_le_bytes())?;
             let mut record = [0u8; 50];
             for (k, t) in mesh.triangles.iter().enumerate() {
-                let normal = mesh.face_normal(k).map(|x| x as f32);
+                let normal: [f32; 3] = mesh.face_normal(k).cast::<f32>().into();
                 let corners = t.map(|v| mesh.position_f32(v as usize));
                 let values = std::iter::once(normal).chain(corners).flatten();
                 for (slot, x) in record.chunks_exact_mut(4).zip(values) {
