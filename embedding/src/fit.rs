@@ -28,6 +28,7 @@ use charts::{Atlas, ChartId, ChartPoint, Geometry, Lft, ModelPoint, Polygon};
 use faer::Mat;
 use faer::prelude::*;
 use faer::sparse::{SparseColMat, Triplet};
+use mesh::HalfEdgeMesh;
 use num_complex::Complex64;
 
 use crate::holed::HoledMesh;
@@ -188,87 +189,87 @@ pub fn vertex_areas(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<f64> {
 pub fn cut(mesh: &HoledMesh) -> Result<CutDisk, EmbeddingError> {
     let fail = |what: &str| EmbeddingError::Parameterization(what.to_string());
     let n = mesh.positions.len();
+    let he = HalfEdgeMesh::from_polygons(n, mesh.triangles.iter().map(|t| &t[..]))
+        .map_err(|e| fail(&e.to_string()))?;
+    let topology = he.topology();
+    if topology.isolated_vertices > 0 {
+        return Err(fail("a mesh vertex belongs to no triangle"));
+    }
+    if topology.misoriented_edges > 0 || topology.nonmanifold_edges > 0 {
+        return Err(fail("an edge is used twice in the same direction"));
+    }
+    if !topology.closed {
+        return Err(fail("the mesh has a boundary"));
+    }
     let is_cut: std::collections::HashSet<(u32, u32)> = mesh
         .loops
         .iter()
         .flat_map(|l| l.windows(2).map(|w| (w[0].min(w[1]), w[0].max(w[1]))))
         .collect();
-    let cut_edge = |a: u32, b: u32| is_cut.contains(&(a.min(b), a.max(b)));
-    let mut by_edge: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * mesh.triangles.len());
-    let mut corners: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            if by_edge.insert((tri[k], tri[(k + 1) % 3]), t).is_some() {
-                return Err(fail("an edge is used twice in the same direction"));
-            }
-            corners[tri[k] as usize].push((t, k));
-        }
-    }
-    let mut copy = vec![[u32::MAX; 3]; mesh.triangles.len()];
+    let cut_edge = |h: u32| {
+        let (a, b) = (he.origin(h), he.target(h));
+        is_cut.contains(&(a.min(b), a.max(b)))
+    };
+    // A corner is named by its outgoing half-edge; triangle t's corner k is half-edge 3t + k.
+    let mut copy = vec![u32::MAX; he.halfedge_count()];
     let mut original = Vec::new();
-    for v in 0..n as u32 {
-        let fan = &corners[v as usize];
-        if fan.is_empty() {
-            return Err(fail("a mesh vertex belongs to no triangle"));
-        }
-        // Wedges start at a corner whose incoming edge {v, a} is a loop edge; a vertex off the loops
-        // is one wedge, started anywhere.
-        let tri = |t: usize| mesh.triangles[t];
-        let starts: Vec<(usize, usize)> = fan
-            .iter()
-            .copied()
-            .filter(|&(t, k)| cut_edge(v, tri(t)[(k + 1) % 3]))
-            .collect();
+    for (v, fan) in he.outgoing().into_iter().enumerate() {
+        // Wedges start at a corner whose outgoing edge is a loop edge, and turn clockwise (across
+        // the incoming edge) until the next loop edge; a vertex off the loops is one wedge.
+        let starts: Vec<u32> = fan.iter().copied().filter(|&h| cut_edge(h)).collect();
         let starts = if starts.is_empty() {
             vec![fan[0]]
         } else {
             starts
         };
-        for (mut t, mut k) in starts {
+        for mut h in starts {
             let id = original.len() as u32;
-            original.push(v);
-            loop {
-                if copy[t][k] != u32::MAX {
-                    break; // came round the whole fan (a vertex off the loops)
-                }
-                copy[t][k] = id;
-                let b = tri(t)[(k + 2) % 3];
-                if cut_edge(v, b) {
+            original.push(v as u32);
+            while copy[h as usize] == u32::MAX {
+                copy[h as usize] = id;
+                let incoming = he.prev(h);
+                if cut_edge(incoming) {
                     break;
                 }
-                t = *by_edge
-                    .get(&(v, b))
+                h = he
+                    .twin(incoming)
                     .ok_or_else(|| fail("the mesh has a boundary"))?;
-                k = (0..3).find(|&k| tri(t)[k] == v).expect("v is a corner");
             }
         }
     }
-    if copy.iter().flatten().any(|&c| c == u32::MAX) {
+    if copy.contains(&u32::MAX) {
         return Err(fail("the mesh is not a manifold at some vertex"));
     }
-    let boundary = boundary_cycle(&copy, original[..].iter().position(|&o| o == mesh.base))?;
+    let triangles: Vec<[u32; 3]> = (0..he.face_count() as u32)
+        .map(|f| {
+            let hs = he.face_halfedges(f);
+            [0, 1, 2].map(|k| copy[(hs.start + k) as usize])
+        })
+        .collect();
+    let start = original.iter().position(|&o| o == mesh.base);
+    let boundary = boundary_cycle(original.len(), &triangles, start)?;
     let arcs = label_arcs(mesh, &original, &boundary)?;
     Ok(CutDisk {
         original,
-        triangles: copy,
+        triangles,
         boundary,
         arcs,
     })
 }
 
-/// The boundary of a disk as one counter-clockwise cycle of vertices, from `start`.
+/// The boundary of a disk (its half-edges without a twin) as one counter-clockwise cycle of
+/// vertices, from `start`.
 fn boundary_cycle(
+    vertex_count: usize,
     triangles: &[[u32; 3]],
     start: Option<usize>,
 ) -> Result<Vec<u32>, EmbeddingError> {
     let fail = |what: &str| EmbeddingError::Parameterization(what.to_string());
-    let edges: std::collections::HashSet<(u32, u32)> = triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-        .collect();
+    let he = HalfEdgeMesh::from_polygons(vertex_count, triangles.iter().map(|t| &t[..]))
+        .map_err(|e| fail(&e.to_string()))?;
     let mut next = HashMap::new();
-    for &(a, b) in &edges {
-        if !edges.contains(&(b, a)) && next.insert(a, b).is_some() {
+    for h in (0..he.halfedge_count() as u32).filter(|&h| he.twin(h).is_none()) {
+        if next.insert(he.origin(h), he.target(h)).is_some() {
             return Err(fail(
                 "the cut mesh is not a disk (a boundary vertex repeats)",
             ));

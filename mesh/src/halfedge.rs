@@ -198,6 +198,20 @@ impl HalfEdgeMesh {
         self.face_of[h as usize]
     }
 
+    /// Face f's half-edges, in order: side i runs from corner i to corner i + 1.
+    pub fn face_halfedges(&self, f: u32) -> std::ops::Range<u32> {
+        self.face_start[f as usize]..self.face_start[f as usize + 1]
+    }
+
+    /// Every vertex's outgoing half-edges (unordered).
+    pub fn outgoing(&self) -> Vec<Vec<u32>> {
+        let mut out = vec![Vec::new(); self.vertex_count];
+        for (h, &v) in self.origin.iter().enumerate() {
+            out[v as usize].push(h as u32);
+        }
+        out
+    }
+
     pub fn origin(&self, h: u32) -> u32 {
         self.origin[h as usize]
     }
