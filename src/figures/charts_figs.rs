@@ -5,10 +5,10 @@ use charts::{Atlas, Chart, ChartId, ChartKind, Domain};
 use num_complex::Complex64;
 
 use super::geometry::{
-    corner_positions, domain_boundary, domain_grid, nearest, side_points, tile_maps,
-    vertex_wedge_corners,
+    corner_positions, domain_boundary, domain_grid, nearest, tile_maps, vertex_wedge_corners,
 };
 use super::palette;
+use super::polygons::draw_sides;
 use super::svg::{Doc, Font, Frame, HEADING_FONT, Label, edge_label, polyline_data};
 
 /// A chart's name as a label: "inside chart", "edge chart a₁", "vertex chart".
@@ -89,24 +89,6 @@ fn draw_disk_and_polygon(doc: &mut Doc, atlas: &Atlas, frame: Frame, outline_id:
     doc.clip(outline_id, &outline);
     doc.path(&outline, "fill=\"#f4f4f4\" stroke=\"none\"");
     outline
-}
-
-/// The polygon's sides, each in its pair's colour.
-fn draw_sides(doc: &mut Doc, atlas: &Atlas, frame: Frame, width: f64) {
-    let poly = atlas.polygon().expect("a polygon atlas");
-    for e in 0..poly.sides() {
-        let pts: Vec<Complex64> = side_points(poly, e, 40)
-            .into_iter()
-            .map(|z| frame.px(z))
-            .collect();
-        doc.polyline(
-            &pts,
-            &format!(
-                "fill=\"none\" stroke=\"{}\" stroke-width=\"{width:.1}\" stroke-linecap=\"round\"",
-                palette::stroke(palette::edge_kind(e))
-            ),
-        );
-    }
 }
 
 /// The chart's image in the polygon: the raw image of its domain (one LFT) dashed, and the image
@@ -220,7 +202,8 @@ pub fn figure4(atlas: &Atlas) -> String {
         let clip_id = format!("fig4-polygon-{c}");
         draw_disk_and_polygon(&mut doc, atlas, bottom, &clip_id);
         draw_image(&mut doc, atlas, chart, bottom, &clip_id);
-        draw_sides(&mut doc, atlas, bottom, 2.0);
+        let poly = atlas.polygon().expect("a polygon atlas");
+        draw_sides(&mut doc, poly, bottom, 40, 2.0);
         match chart.kind() {
             ChartKind::Edge { handle, side } => {
                 for e in [

@@ -175,19 +175,7 @@ pub fn figure3(atlas: &Atlas, poly: &Polygon) -> String {
         }
         doc.end();
     }
-    for e in 0..poly.sides() {
-        let pts: Vec<Complex64> = side_points(poly, e, 48)
-            .into_iter()
-            .map(|z| frame.px(z))
-            .collect();
-        doc.polyline(
-            &pts,
-            &format!(
-                "fill=\"none\" stroke=\"{}\" stroke-width=\"3.5\" stroke-linecap=\"round\"",
-                palette::stroke(palette::edge_kind(e))
-            ),
-        );
-    }
+    draw_sides(&mut doc, poly, frame, 48, 3.5);
     let ink = "#000000";
     let measure = "stroke=\"#000000\" stroke-width=\"1.6\"";
     let origin = frame.px(Complex64::ZERO);
@@ -264,4 +252,21 @@ pub fn figure3(atlas: &Atlas, poly: &Polygon) -> String {
         poly.sides(),
         poly.genus()
     ))
+}
+
+/// The polygon's sides, each in its pair's colour, as polylines of `samples` points.
+pub(super) fn draw_sides(doc: &mut Doc, poly: &Polygon, frame: Frame, samples: usize, width: f64) {
+    for e in 0..poly.sides() {
+        let pts: Vec<Complex64> = side_points(poly, e, samples)
+            .into_iter()
+            .map(|z| frame.px(z))
+            .collect();
+        doc.polyline(
+            &pts,
+            &format!(
+                "fill=\"none\" stroke=\"{}\" stroke-width=\"{width:.1}\" stroke-linecap=\"round\"",
+                palette::stroke(palette::edge_kind(e))
+            ),
+        );
+    }
 }
