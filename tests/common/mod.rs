@@ -12,21 +12,38 @@ pub fn ntori() -> assert_cmd::Command {
     assert_cmd::Command::cargo_bin("ntori").expect("the ntori binary is built")
 }
 
-/// The genera [`small_model`] caches.
-pub const SMALL_MODEL_GENERA: u32 = 9;
+/// Where the example models live (see assets/README.md).
+pub fn asset(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets")
+        .join(name)
+}
 
-/// A small fitted model of genus 0 to 8 (an 8×8 grid per chart fitted to a resolution-16 mesh:
-/// seconds, not minutes), fitted once per test binary and genus.
+/// The genera of the example models in `assets/models/`.
+pub const SMALL_MODEL_GENERA: std::ops::RangeInclusive<u32> = 0..=3;
+
+/// The small fitted model of genus 0 to 3 from `assets/models/` (an 8×8 grid per chart fitted to a
+/// resolution-16 mesh), loaded once per test binary and genus. `tests/library/assets.rs` checks that
+/// the files are what the fit makes.
 pub fn small_model(genus: u32) -> &'static Surface {
-    static MODELS: [OnceLock<Surface>; SMALL_MODEL_GENERA as usize] =
-        [const { OnceLock::new() }; SMALL_MODEL_GENERA as usize];
+    static MODELS: [OnceLock<Surface>; 4] = [const { OnceLock::new() }; 4];
+    assert!(
+        SMALL_MODEL_GENERA.contains(&genus),
+        "no example model of genus {genus}"
+    );
     MODELS[genus as usize].get_or_init(|| {
-        let settings = SplineSettings {
-            grid: 8,
-            ..SplineSettings::default()
-        };
-        initial_model(genus, 16, settings, FitSettings::default())
-            .expect("the small model fits")
-            .surface
+        let path = asset(&format!("models/genus-{genus}.json"));
+        ntori::io::model_file::load(&path).expect("the example model loads")
     })
+}
+
+/// The settings and input resolution the example models were fitted with.
+pub fn small_model_fit(genus: u32) -> Surface {
+    let settings = SplineSettings {
+        grid: 8,
+        ..SplineSettings::default()
+    };
+    initial_model(genus, 16, settings, FitSettings::default())
+        .expect("the small model fits")
+        .surface
 }

@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod assets;
 mod export;
 mod figures;
 mod fit;
