@@ -3,7 +3,6 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Context as _;
 use ntori::io::export::{self, Encoding, ExportError, Format};
 
 use super::write_stdout;
@@ -95,21 +94,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let model = ntori::io::model_file::load(&model_path)?;
     export::check_resolution(model.genus(), te, tr)?;
-    let mesh = export::surface_mesh(&model, te, tr).with_context(|| {
-        format!(
-            "cannot export {}: cannot mesh its surface",
-            model_path.display()
-        )
-    })?;
-    let folded = mesh.folded_triangles();
-    if folded > 0 {
+    let exported = export::export_surface(&model, (te, tr), output, format, encoding).map_err(
+        |e| match e {
+            // Writing failed: the file error says which file and why.
+            ExportError::File(_) | ExportError::GlbTooLarge(_) => anyhow::Error::new(e),
+            other => anyhow::Error::new(other).context(format!(
+                "cannot export {}: cannot mesh its surface",
+                model_path.display()
+            )),
+        },
+    )?;
+    if exported.folded > 0 {
         eprintln!(
-            "ntori: warning: {folded} of {} triangles face against the surface's normals: \
+            "ntori: warning: {} of {} triangles face against the surface's normals: \
              t_e = {te}, t_r = {tr} is too coarse for this surface (raise them)",
-            mesh.triangles.len()
+            exported.folded, exported.triangles
         );
     }
-    export::write(&mesh, output, format, encoding)?;
     if !quiet {
         let kind = match (format.has_encodings(), encoding) {
             (false, _) => String::new(),
@@ -119,9 +120,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         write_stdout(&format!(
             "wrote {}: {format}{kind}, genus {}, t_e = {te}, t_r = {tr}, {} vertices, {} triangles\n",
             output.display(),
-            mesh.genus,
-            mesh.positions.len(),
-            mesh.triangles.len()
+            model.genus(),
+            exported.vertices,
+            exported.triangles
         ))?;
     }
     Ok(ExitCode::SUCCESS)

@@ -394,8 +394,18 @@ impl EditorApp {
                         .error(format!("cannot use the new settings: {e}")),
                 }
             }
-            Ok(JobOutput::Exported { triangles, path }) => self.messages.info(format!(
-                "exported {triangles} triangles to {}",
+            Ok(JobOutput::Exported { exported, path }) if exported.folded > 0 => {
+                self.messages.error(format!(
+                    "exported {} triangles to {}, but {} of them face against the surface: \
+                     the tessellation is too coarse for this surface (raise t_e, t_r)",
+                    exported.triangles,
+                    path.display(),
+                    exported.folded
+                ))
+            }
+            Ok(JobOutput::Exported { exported, path }) => self.messages.info(format!(
+                "exported {} triangles to {}",
+                exported.triangles,
                 path.display()
             )),
             Err(e) => self.messages.error(e.to_string()),

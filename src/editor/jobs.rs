@@ -28,7 +28,10 @@ pub enum JobOutput {
         worst: f64,
     },
     /// The mesh was written.
-    Exported { triangles: usize, path: PathBuf },
+    Exported {
+        exported: export::Exported,
+        path: PathBuf,
+    },
 }
 
 /// Why a job failed.
@@ -118,12 +121,9 @@ impl Jobs {
     pub fn export(&mut self, surface: Surface, (te, tr): (u32, u32), path: PathBuf) {
         self.spawn("exporting".into(), move || {
             let format = Format::from_path(&path)?;
-            let mesh = export::surface_mesh(&surface, te, tr)?;
-            export::write(&mesh, &path, format, Encoding::Binary)?;
-            Ok(JobOutput::Exported {
-                triangles: mesh.triangles.len(),
-                path,
-            })
+            let exported =
+                export::export_surface(&surface, (te, tr), &path, format, Encoding::Binary)?;
+            Ok(JobOutput::Exported { exported, path })
         });
     }
 

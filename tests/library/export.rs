@@ -589,3 +589,22 @@ fn a_failed_write_leaves_no_file() {
     assert_eq!(std::fs::read(&path).unwrap(), b"before");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
+
+#[test]
+fn export_surface_writes_what_surface_mesh_makes_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    for (genus, te, tr) in [(0, 16, 16), (2, 16, 16), (2, 2, 1), (3, 5, 7)] {
+        let surface = crate::common::small_model(genus);
+        let path = dir.path().join(format!("g{genus}-{te}-{tr}.off"));
+        let exported =
+            export::export_surface(surface, (te, tr), &path, Format::Off, Encoding::Ascii).unwrap();
+        let mesh = surface_mesh(surface, te, tr).unwrap();
+        assert_eq!(exported.vertices, mesh.positions.len());
+        assert_eq!(exported.triangles, mesh.triangles.len());
+        assert_eq!(exported.folded, mesh.folded_triangles());
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            write(&mesh, Format::Off, Encoding::Ascii)
+        );
+    }
+}

@@ -373,6 +373,34 @@ impl SurfaceMesh {
     }
 }
 
+/// What [`export_surface`] wrote.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Exported {
+    pub vertices: usize,
+    pub triangles: usize,
+    /// Triangles facing against the surface's normals ([`SurfaceMesh::folded_triangles`]): the
+    /// tessellation is too coarse for the surface where this is not zero.
+    pub folded: usize,
+}
+
+/// The export behind `ntori export` and the editor's: tessellates and evaluates `surface` at
+/// t_e, t_r ([`surface_mesh`]) and writes it to `path` ([`write()`]).
+pub fn export_surface(
+    surface: &Surface,
+    (te, tr): (u32, u32),
+    path: &Path,
+    format: Format,
+    encoding: Encoding,
+) -> Result<Exported, ExportError> {
+    let mesh = surface_mesh(surface, te, tr)?;
+    write(&mesh, path, format, encoding)?;
+    Ok(Exported {
+        vertices: mesh.positions.len(),
+        triangles: mesh.triangles.len(),
+        folded: mesh.folded_triangles(),
+    })
+}
+
 /// Writes `mesh` to `path` atomically in `format` (`encoding` matters for PLY and STL only).
 pub fn write(
     mesh: &SurfaceMesh,
