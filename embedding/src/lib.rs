@@ -29,6 +29,7 @@ pub mod floater;
 pub mod holed;
 pub mod integrals;
 pub mod model;
+pub mod quality;
 pub mod spline_surface;
 pub mod stencil;
 pub mod surface;

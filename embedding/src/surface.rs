@@ -159,6 +159,13 @@ impl SurfaceJet {
         let ((e, f, g), (l, m, n)) = (self.first_form(), self.second_form());
         (e * n - 2.0 * f * m + g * l) / (2.0 * (e * g - f * f))
     }
+    /// The principal curvatures κ₁ ≥ κ₂ (H ± √(H² − K), with respect to [`SurfaceJet::normal`]).
+    pub fn principal_curvatures(&self) -> (f64, f64) {
+        let (k, h) = (self.gaussian_curvature(), self.mean_curvature());
+        // H² ≥ K holds exactly; rounding can make the difference a hair negative at umbilics.
+        let root = (h * h - k).max(0.0).sqrt();
+        (h + root, h - root)
+    }
     /// The area element |S_u × S_v|.
     pub fn area_element(&self) -> f64 {
         self.du.cross(&self.dv).norm()

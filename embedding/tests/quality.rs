@@ -1,0 +1,159 @@
+//! The shape measures (`embedding::quality`) measure what they say: a known disagreement between
+//! patches is found exactly, principal curvatures agree with K and H, a round sphere has curvature
+//! 1/R, and the normal deviation from a mesh falls as the mesh approaches the surface and rises
+//! when the mesh is made rough.
+
+use std::sync::Arc;
+
+use charts::{Atlas, ChartId};
+use embedding::fit::{FitSettings, initial_model};
+use embedding::quality::{
+    max_principal_curvature, normal_deviation, patch_disagreement, sample_points,
+};
+use embedding::{Layout, Model, Point3, SplineSettings, Stencil, Surface, Vector3};
+use proptest::prelude::*;
+
+fn surface(genus: u32, control: impl FnOnce(&Layout) -> Vec<Point3>) -> Surface {
+    let atlas = Arc::new(Atlas::new(genus).unwrap());
+    let settings = SplineSettings::default();
+    let control = control(&Layout::new(&atlas, settings).unwrap());
+    Surface::new(atlas, settings, control).unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Every patch constant, one chart's moved by d: wherever that chart overlaps another with
+    /// weight, the patches are exactly |d| apart, and nowhere more.
+    #[test]
+    fn moving_one_chart_makes_its_patches_disagree_by_the_move(
+        genus in prop::sample::select(vec![0u32, 1, 2, 3, 5, 8]),
+        chart in 0usize..64,
+        d in prop::array::uniform3(-2.0f64..2.0),
+    ) {
+        let d = Vector3::from(d);
+        prop_assume!(d.norm() > 1e-3);
+        let mut moved = None;
+        let s = surface(genus, |layout| {
+            let charts = layout.atlas().charts().len();
+            let c = ChartId((chart % charts) as u32);
+            moved = Some(c);
+            let grid = layout.settings().grid;
+            let mut control = Model::constant(layout, Point3::new(0.5, -1.0, 2.0)).points();
+            for j in 0..grid {
+                for i in 0..grid {
+                    control[layout.control_index(c, i, j)] += d;
+                }
+            }
+            control
+        });
+        let found = patch_disagreement(&s, &sample_points(&s, 16).unwrap(), 0.1);
+        prop_assert!(found.compared > 0);
+        prop_assert!((found.max - d.norm()).abs() <= 1e-12 * (1.0 + d.norm()),
+            "genus {genus}, chart {moved:?}: {} vs {}", found.max, d.norm());
+        // The worst point is one the moved chart holds.
+        let worst = found.worst.unwrap();
+        let holders = s.atlas().locate(worst).unwrap();
+        prop_assert!(holders.representations().iter().any(|r| Some(r.chart) == moved));
+    }
+
+    /// κ₁ ≥ κ₂, κ₁κ₂ = K and (κ₁ + κ₂)/2 = H at random points of a random smooth surface.
+    #[test]
+    fn principal_curvatures_agree_with_k_and_h(
+        genus in prop::sample::select(vec![0u32, 1, 2, 3]),
+        seed in any::<u64>(),
+        u in 0.0f64..1.0, v in 0.0f64..1.0, c in 0usize..16,
+    ) {
+        let s = surface(genus, |layout| {
+            let mut x = seed | 1;
+            (0..layout.control_count())
+                .map(|k| {
+                    x ^= x << 13; x ^= x >> 7; x ^= x << 17;
+                    let r = (x >> 11) as f64 / (1u64 << 53) as f64;
+                    Point3::new(k as f64 * 0.01, (k as f64 * 0.37).sin(), r)
+                })
+                .collect()
+        });
+        let p = charts::check::chart_point_from_unit(s.atlas(), c, u, v);
+        let jet = s.eval(p);
+        let (k1, k2) = jet.principal_curvatures();
+        let (k, h) = (jet.gaussian_curvature(), jet.mean_curvature());
+        prop_assume!(k.is_finite() && h.is_finite());
+        let scale = 1.0 + k1.abs().max(k2.abs());
+        prop_assert!(k1 >= k2);
+        prop_assert!((0.5 * (k1 + k2) - h).abs() <= 1e-9 * scale);
+        if h * h - k > 1e-9 * scale * scale {
+            prop_assert!((k1 * k2 - k).abs() <= 1e-7 * scale * scale, "{k1} {k2} {k}");
+        }
+    }
+}
+
+#[test]
+fn a_fitted_sphere_has_curvature_near_one_over_its_radius() {
+    let settings = SplineSettings {
+        grid: 8,
+        ..SplineSettings::default()
+    };
+    let fit = initial_model(0, 16, settings, FitSettings::default()).unwrap();
+    let s = &fit.surface;
+    let points = sample_points(s, 12).unwrap();
+    let layout = s.layout();
+    let positions: Vec<Point3> = points
+        .iter()
+        .map(|&p| layout.eval(s.control_points(), p).pos)
+        .collect();
+    let centre =
+        positions.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / positions.len() as f64;
+    let radius = positions
+        .iter()
+        .map(|p| (p.coords - centre).norm())
+        .sum::<f64>()
+        / positions.len() as f64;
+    let extreme = max_principal_curvature(s, &points);
+    assert!(
+        extreme.max_abs >= 0.99 / radius && extreme.max_abs <= 1.5 / radius,
+        "κ max {} against 1/R = {}",
+        extreme.max_abs,
+        1.0 / radius
+    );
+}
+
+#[test]
+fn normal_deviation_falls_as_the_mesh_refines_and_rises_when_it_is_rough() {
+    let settings = SplineSettings {
+        grid: 8,
+        ..SplineSettings::default()
+    };
+    let fit = initial_model(2, 16, settings, FitSettings::default()).unwrap();
+    let s = &fit.surface;
+    let mesh_at = |t: u32| {
+        let tess = s.atlas().tessellate(t, t).unwrap();
+        let stencil = Stencil::build(&s.layout(), &tess.vertices);
+        let mut positions = vec![Point3::origin(); stencil.rows()];
+        stencil.positions(s.control_points(), &mut positions);
+        (tess, positions)
+    };
+    let (coarse, coarse_positions) = mesh_at(8);
+    let (fine, fine_positions) = mesh_at(32);
+    let at_8 = normal_deviation(s, &coarse.vertices, &coarse_positions, &coarse.triangles);
+    let at_32 = normal_deviation(s, &fine.vertices, &fine_positions, &fine.triangles);
+    assert!(at_32.p90 < at_8.p90, "{at_32:?} vs {at_8:?}");
+    assert!(at_32.p90 < 3.0, "{at_32:?}");
+    assert!(at_32.median <= at_32.p90 && at_32.p90 <= at_32.max);
+    // Roughen the fine mesh by a tenth of its edge length: the normals scatter.
+    let size = s.control_net_size();
+    let rough: Vec<Point3> = fine_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let k = i as f64;
+            p + Vector3::new((k * 12.9898).sin(), (k * 78.233).sin(), (k * 37.719).sin())
+                * (2e-3 * size)
+        })
+        .collect();
+    let roughened = normal_deviation(s, &fine.vertices, &rough, &fine.triangles);
+    assert!(
+        roughened.p90 > 2.0 * at_32.p90,
+        "{roughened:?} vs {at_32:?}"
+    );
+}
