@@ -7,5 +7,6 @@ mod common;
 mod export;
 mod figures;
 mod fit;
+mod hardening;
 mod render;
 mod tessellation;
