@@ -79,11 +79,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         quiet,
     } = args;
-    if output.exists() && !force {
-        anyhow::bail!(
-            "{} exists; pass --force to replace it, or -o to write elsewhere",
-            output.display()
-        );
+    // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
+    // special file, and without --force it does not exist yet.
+    let target = ntori::io::atomic::check_output(&output, &[])?;
+    if !force && std::fs::symlink_metadata(&target).is_ok() {
+        return Err(ntori::io::atomic::FileError::Exists { path: output }.into());
     }
     let settings = SplineSettings {
         degree: degree as usize,
@@ -101,7 +101,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     });
     bar.finish_and_clear();
     let (model, report) = made.with_context(|| format!("cannot make a genus-{genus} model"))?;
-    ntori::io::model_file::save(&output, &model)?;
+    if force {
+        ntori::io::model_file::save(&output, &model)?;
+    } else {
+        // Exclusive: a file created at the output during the fit is kept, not replaced.
+        ntori::io::model_file::save_new(&output, &model)?;
+    }
     emit(
         &Written {
             report: &report,

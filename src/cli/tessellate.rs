@@ -68,6 +68,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         svg: svg_path,
     } = args;
+    if let Some(path) = &svg_path {
+        ntori::io::atomic::check_output(path, &[])?;
+    }
     let atlas =
         Atlas::new(genus).with_context(|| format!("cannot build the charts for genus {genus}"))?;
     let t = atlas

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use embedding::{EmbeddingError, Model, ModelHeader, Surface};
 use serde::Deserialize as _;
 
-use crate::io::atomic::{FileError, write_atomically};
+use crate::io::atomic::{FileError, write_atomically, write_new_with};
 
 /// Why a model file could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -104,12 +104,26 @@ pub fn load(path: impl AsRef<Path>) -> Result<Surface, ModelFileError> {
 /// it may).
 pub fn save(path: impl AsRef<Path>, surface: &Surface) -> Result<(), ModelFileError> {
     let path = path.as_ref();
+    let text = model_text(path, surface)?;
+    write_atomically(path, text.as_bytes())?;
+    Ok(())
+}
+
+/// Writes a surface's model file atomically where no file exists: one that appeared meanwhile is
+/// kept and [`FileError::Exists`] returned.
+pub fn save_new(path: impl AsRef<Path>, surface: &Surface) -> Result<(), ModelFileError> {
+    let path = path.as_ref();
+    let text = model_text(path, surface)?;
+    write_new_with(path, |w| w.write_all(text.as_bytes()))?;
+    Ok(())
+}
+
+fn model_text(path: &Path, surface: &Surface) -> Result<String, ModelFileError> {
     let model = surface.to_model();
     let mut text = serde_json::to_string(&model).map_err(|source| ModelFileError::Serialize {
         path: path.to_owned(),
         source,
     })?;
     text.push('\n');
-    write_atomically(path, text.as_bytes())?;
-    Ok(())
+    Ok(text)
 }

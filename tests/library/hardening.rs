@@ -75,3 +75,92 @@ fn editor_upload_checks_its_buffers() {
     let mut small = LiveMesh::new(small_model(2), 2, 2, Style::Shaded).unwrap();
     assert!(renderer.sync(&device, &queue, &mut small, None).is_ok());
 }
+
+#[test]
+fn exclusive_write_keeps_a_file_created_meanwhile() {
+    use ntori::io::atomic::{FileError, write_new_with};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.json");
+    // Another process creates the file while ntori is still writing its own.
+    let err = write_new_with(&path, |w| {
+        std::fs::write(&path, "theirs")?;
+        w.write_all(b"ours")
+    })
+    .expect_err("the file appeared meanwhile");
+    assert!(matches!(err, FileError::Exists { .. }), "{err:?}");
+    assert!(err.to_string().contains("m.json"), "{err}");
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "theirs");
+    // And nothing is left behind.
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["m.json"]);
+    // Where no file exists, it is written.
+    let fresh = dir.path().join("fresh.json");
+    write_new_with(&fresh, |w| w.write_all(b"ours")).unwrap();
+    assert_eq!(std::fs::read_to_string(&fresh).unwrap(), "ours");
+}
+
+/// A process id that no running process has.
+fn dead_pid() -> u32 {
+    (1..4_000_000u32)
+        .rev()
+        .find(|pid| !std::path::Path::new("/proc").join(pid.to_string()).exists())
+        .unwrap()
+}
+
+#[test]
+fn stale_temporaries_of_dead_writers_are_removed() {
+    use ntori::io::atomic::{STALE_AFTER, write_atomically};
+    let dir = tempfile::tempdir().unwrap();
+    let old = std::time::SystemTime::now() - STALE_AFTER - std::time::Duration::from_secs(60);
+    let make = |name: String, modified: std::time::SystemTime| {
+        let path = dir.path().join(name);
+        let file = std::fs::File::create(&path).unwrap();
+        file.set_modified(modified).unwrap();
+        path
+    };
+    let dead = dead_pid();
+    let stale = make(format!(".ntori-{dead}-AbC123.tmp"), old);
+    let recent = make(
+        format!(".ntori-{dead}-DeF456.tmp"),
+        std::time::SystemTime::now(),
+    );
+    let live = make(format!(".ntori-{}-GhI789.tmp", std::process::id()), old);
+    let foreign = make(".other-1-x.tmp".into(), old);
+    write_atomically(&dir.path().join("out.txt"), b"x").unwrap();
+    assert!(!stale.exists(), "a dead writer's old file is litter");
+    assert!(recent.exists(), "a recent file may belong to a reused pid");
+    assert!(live.exists(), "a live writer's file is never touched");
+    assert!(foreign.exists(), "only ntori's own names");
+}
+
+#[test]
+fn file_errors_name_the_target_not_a_temporary_file() {
+    use ntori::io::atomic::write_atomically;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("out.txt");
+    let err = write_atomically_failing(&path);
+    let text = err.to_string();
+    assert!(text.contains("out.txt"), "{text}");
+    assert!(!text.contains(".ntori-"), "{text}");
+    assert_eq!(text.matches("out.txt").count(), 1, "{text}");
+    // A directory that takes no files: the message names the target and the directory once each.
+    let locked = dir.path().join("locked");
+    std::fs::create_dir(&locked).unwrap();
+    std::fs::set_permissions(&locked, std::os::unix::fs::PermissionsExt::from_mode(0o500)).unwrap();
+    let target = locked.join("m.json");
+    if let Err(e) = write_atomically(&target, b"x") {
+        let text = e.to_string();
+        assert!(!text.contains(".ntori-"), "{text}");
+        assert_eq!(text.matches("m.json").count(), 1, "{text}");
+    } // else: running as root, which may write anywhere.
+}
+
+fn write_atomically_failing(path: &std::path::Path) -> ntori::io::atomic::FileError {
+    ntori::io::atomic::write_atomically_with(path, |_| {
+        Err(std::io::Error::other("the writer failed"))
+    })
+    .expect_err("the writer fails")
+}
