@@ -18,6 +18,7 @@ pub type Point3 = Vector3<f64>;
 
 /// The spline and blend parameters of a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SplineSettings {
     /// Degree of the spline patches (3: cubic).
     pub degree: usize,

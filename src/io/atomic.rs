@@ -239,7 +239,8 @@ fn same_file(target: &Path, input: &Path) -> bool {
     }
 }
 
-fn kind_of(file_type: &std::fs::FileType) -> &'static str {
+/// What a file that is not regular is, in words.
+pub(crate) fn kind_of(file_type: &std::fs::FileType) -> &'static str {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt as _;

@@ -232,3 +232,169 @@ fn new_checks_its_output_before_fitting() {
         .stderr(predicate::str::contains("it exists; pass --force"));
     assert_eq!(std::fs::read_to_string(&existing).unwrap(), "mine");
 }
+
+/// A small valid model's JSON, as a tree to break.
+fn model_json(dir: &Path) -> serde_json::Value {
+    let path = constant_model(dir, 1);
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    // Points that differ, so the surface is not degenerate.
+    for (i, p) in value["control_points"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .enumerate()
+    {
+        p[0] = (i as f64).into();
+    }
+    value
+}
+
+#[test]
+fn bad_model_files_get_one_clear_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = model_json(dir.path());
+    let text = serde_json::to_string(&good).unwrap();
+    let edit = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = good.clone();
+        f(&mut v);
+        serde_json::to_string(&v).unwrap()
+    };
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "null.json",
+            edit(&|v| v["control_points"][17][1] = serde_json::Value::Null),
+            "control_points[17].y: invalid type: null, expected f64 (line 1, column",
+        ),
+        (
+            "unknown.json",
+            edit(&|v| v["colour"] = "red".into()),
+            "unknown field `colour`",
+        ),
+        (
+            "version0.json",
+            edit(&|v| v["version"] = 0.into()),
+            "its version is 0",
+        ),
+        (
+            "duplicate.json",
+            text.replacen("{\"", "{\"genus\":3,\"", 1),
+            "duplicate field `genus`",
+        ),
+        (
+            "huge-string.json",
+            edit(&|v| v["genus"] = "y".repeat(1_000_000).into()),
+            "… (1000000 characters)",
+        ),
+        (
+            "truncated.json",
+            text[..100].to_owned(),
+            "is not a JSON file: invalid number (line 1, column 100)",
+        ),
+    ];
+    for (name, contents, expected) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, contents).unwrap();
+        let out = ntori()
+            .arg("export")
+            .arg(&path)
+            .args(["-o"])
+            .arg(dir.path().join("x.obj"))
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains(expected))
+            .stderr(predicate::str::contains("panicked").not());
+        let stderr = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+        assert!(
+            stderr.len() < 600,
+            "{name}: a short message, got {} bytes",
+            stderr.len()
+        );
+        assert_eq!(
+            stderr.matches(name).count(),
+            1,
+            "{name}: the file once: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn model_inputs_must_be_regular_files_of_bounded_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo.json");
+    mkfifo(&fifo);
+    let out = dir.path().join("x.obj");
+    // Each would block or read forever if opened: refused from the file's type and size alone.
+    for (input, expected) in [
+        (fifo.as_path(), "it is a FIFO"),
+        (Path::new("/dev/zero"), "it is a device"),
+        (dir.path(), "it is a directory"),
+    ] {
+        ntori()
+            .arg("export")
+            .arg(input)
+            .arg("-o")
+            .arg(&out)
+            .timeout(std::time::Duration::from_secs(60))
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains(expected));
+    }
+    // A sparse file just past the cap: refused before a byte is read.
+    let big = dir.path().join("big.json");
+    let file = std::fs::File::create(&big).unwrap();
+    file.set_len(ntori::io::model_file::MAX_MODEL_BYTES + 1)
+        .unwrap();
+    ntori()
+        .arg("render")
+        .arg(&big)
+        .arg("-o")
+        .arg(dir.path().join("x.png"))
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(format!(
+            "a model file may have at most {}",
+            ntori::io::model_file::MAX_MODEL_BYTES
+        )));
+}
+
+#[test]
+fn sizes_beyond_the_memory_caps_are_refused_before_any_work() {
+    // tessellate: genus 2 at t_e = 1000 would take 3.4 GB.
+    ntori()
+        .args(["tessellate", "-g", "2", "--te", "1000"])
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "genus 2 at t_e = 1000, t_r = 4 makes 8112000 triangles, about 4.5 GB",
+        ))
+        .stderr(predicate::str::contains("at most 4000000 triangles"));
+    // new: genus 8 at resolution 1024 ran 15 minutes to 10.9 GB; now refused while meshing.
+    let dir = tempfile::tempdir().unwrap();
+    ntori()
+        .args(["new", "-g", "8", "--resolution", "1024", "-q", "-o"])
+        .arg(dir.path().join("m.json"))
+        .timeout(std::time::Duration::from_secs(120))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("makes more than"))
+        .stderr(predicate::str::contains("lower the resolution"));
+    assert!(!dir.path().join("m.json").exists());
+    // render: genus 64 at T = 64 is 5.2 million triangles (within the buffer cap, over the
+    // triangle cap; a device with less than 750 MB per buffer says so first).
+    let model = constant_model(dir.path(), 64);
+    ntori()
+        .arg("render")
+        .arg(&model)
+        .args(["--tessellation", "64", "-q", "-o"])
+        .arg(dir.path().join("m.png"))
+        .timeout(std::time::Duration::from_secs(120))
+        .assert()
+        .code(1)
+        .stderr(
+            predicate::str::contains("makes 5210112 triangles; a picture may have at most 4000000")
+                .or(predicate::str::contains("max_buffer_size")),
+        );
+}

@@ -164,3 +164,32 @@ fn write_atomically_failing(path: &std::path::Path) -> ntori::io::atomic::FileEr
     })
     .expect_err("the writer fails")
 }
+
+#[test]
+fn fits_beyond_the_memory_cap_are_refused_before_fitting() {
+    use embedding::EmbeddingError;
+    use embedding::fit::{FitSettings, MAX_FIT_TRIANGLES, initial_model};
+    let settings = embedding::SplineSettings::default();
+    // Genus 64 makes 1.8 million triangles even at resolution 8: meshing stops at the cap.
+    let err = initial_model(64, 8, settings, FitSettings::default())
+        .err()
+        .expect("refused");
+    let EmbeddingError::FitTooLarge {
+        triangles,
+        at_least,
+        max,
+        ..
+    } = &err
+    else {
+        panic!("expected FitTooLarge, got {err:?}");
+    };
+    assert!(*at_least && *triangles > MAX_FIT_TRIANGLES && *max == MAX_FIT_TRIANGLES);
+    let text = err.to_string();
+    assert!(
+        text.contains("GB to fit") && text.contains("lower the resolution"),
+        "{text}"
+    );
+    // The largest genus-16 mesh at resolution 32 is within the cap: it is meshed, not refused.
+    let mesh = embedding::holed::HoledMesh::new(16, 32).unwrap();
+    assert!(mesh.triangles.len() <= MAX_FIT_TRIANGLES);
+}
