@@ -52,6 +52,21 @@ pub enum RenderError {
         triangles: u64,
         max: u64,
     },
+    #[error("the surface is degenerate: its control points coincide, so it has no area to draw")]
+    Degenerate,
+    #[error(
+        "vertex {index} lies at ({x:e}, {y:e}, {z:e}), beyond the 32-bit floats the GPU draws with (±3.4e38); scale the model down"
+    )]
+    NotDrawable {
+        index: usize,
+        x: f64,
+        y: f64,
+        z: f64,
+    },
+    #[error(
+        "the surface spans {extent:e}, below what the GPU's 32-bit floats can tell apart: it would be drawn as one point; scale the model up"
+    )]
+    Collapses { extent: f64 },
     #[error("reading the image back from the GPU failed: {0}")]
     Readback(String),
     #[error("the PNG could not be encoded: {0}")]

@@ -398,3 +398,70 @@ fn sizes_beyond_the_memory_caps_are_refused_before_any_work() {
                 .or(predicate::str::contains("max_buffer_size")),
         );
 }
+
+/// The small fitted torus with every control point multiplied by `scale` (and point 0 moved to
+/// `outlier` where given), written to `dir/name`.
+fn scaled_model(dir: &Path, name: &str, scale: f64, outlier: Option<f64>) -> std::path::PathBuf {
+    let mut model = crate::common::small_model(1).to_model();
+    for p in &mut model.control_points {
+        *p = p.map(|x| x * scale);
+    }
+    if let Some(o) = outlier {
+        model.control_points[0] = [o, o, o];
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_string(&model).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn numbers_that_do_not_survive_f32_are_refused_not_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let huge = scaled_model(dir.path(), "huge.json", 1e39, None);
+    let outlier = scaled_model(dir.path(), "outlier.json", 1.0, Some(1e155));
+    let tiny = scaled_model(dir.path(), "tiny.json", 1e-46, None);
+    let fine = scaled_model(dir.path(), "fine.json", 1.0, None);
+    for ext in ["obj", "ply", "stl", "glb", "off"] {
+        let out = dir.path().join(format!("m.{ext}"));
+        for (model, expected) in [
+            (&huge, "beyond the 32-bit floats"),
+            (&outlier, "beyond the 32-bit floats"),
+            (&tiny, "below what the 32-bit floats"),
+        ] {
+            ntori()
+                .arg("export")
+                .arg(model)
+                .args(["--te", "4", "--tr", "4", "-q", "-o"])
+                .arg(&out)
+                .assert()
+                .code(1)
+                .stderr(predicate::str::contains(expected));
+            assert!(!out.exists(), "{ext}: nothing written");
+        }
+        // The same surface at a sane scale exports.
+        ntori()
+            .arg("export")
+            .arg(&fine)
+            .args(["--te", "4", "--tr", "4", "-q", "-o"])
+            .arg(&out)
+            .assert()
+            .success();
+    }
+    let png = dir.path().join("m.png");
+    let constant = constant_model(dir.path(), 1);
+    for (model, expected) in [
+        (&huge, "beyond the 32-bit floats the GPU"),
+        (&tiny, "below what the GPU's 32-bit floats"),
+        (&constant, "the surface is degenerate"),
+    ] {
+        ntori()
+            .arg("render")
+            .arg(model)
+            .args(["--size", "64x48", "--tessellation", "4", "-q", "-o"])
+            .arg(&png)
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains(expected));
+        assert!(!png.exists());
+    }
+}
