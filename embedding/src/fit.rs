@@ -878,7 +878,12 @@ pub fn fit(
         .map(|c| Point3::new(x[(c, 0)], x[(c, 1)], x[(c, 2)]))
         .collect();
     if control.iter().any(|c| !c.iter().all(|v| v.is_finite())) {
-        return Err(EmbeddingError::Unsolvable);
+        // Not `Unsolvable` (that is the edit's): say what of the fit's input can cause it.
+        return Err(EmbeddingError::Parameterization(format!(
+            "the least-squares fit gave control points that are not finite numbers \
+             (smoothness weight {}: far too large or too small for the data?)",
+            settings.smoothness
+        )));
     }
     Ok(control)
 }

@@ -56,7 +56,8 @@ pub struct Args {
           value_parser = clap::value_parser!(u64).range(1..=4))]
     continuity: u64,
     /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term).
-    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ")]
+    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ",
+          value_parser = parse_smoothness)]
     smoothness: f64,
     /// Print the report as JSON.
     #[arg(long)]
@@ -118,6 +119,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
 /// The report once the model is saved: as text it also says where the model went; as JSON it is
 /// the report alone.
+/// The largest smoothness weight accepted: beyond it the least-squares system is the smoothness
+/// term alone to f64 precision (λ = 1e308 overflowed into non-finite control points).
+const MAX_SMOOTHNESS: f64 = 1e6;
+
+/// λ: a number in (0, 1e6].
+fn parse_smoothness(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v > 0.0 && v <= MAX_SMOOTHNESS {
+        Ok(v)
+    } else {
+        Err(format!(
+            "the smoothness weight must lie in (0, {MAX_SMOOTHNESS:e}], got {v}"
+        ))
+    }
+}
+
 #[derive(Serialize)]
 #[serde(transparent)]
 struct Written<'a> {

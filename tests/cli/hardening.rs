@@ -465,3 +465,86 @@ fn numbers_that_do_not_survive_f32_are_refused_not_written() {
         assert!(!png.exists());
     }
 }
+
+#[test]
+fn messages_are_plain_and_said_once() {
+    let dir = tempfile::tempdir().unwrap();
+    // -1 is refused as a genus, not with u32's range.
+    ntori()
+        .args(["info", "--genus", "-1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "a genus is 0 or more (0 to 64), got -1",
+        ))
+        .stderr(predicate::str::contains("4294967295").not());
+    // An absurd smoothness is an argument error, not "the edit's constraints could not be solved".
+    ntori()
+        .args(["new", "-g", "1", "--smoothness", "1e308", "-q", "-o"])
+        .arg(dir.path().join("m.json"))
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "the smoothness weight must lie in (0, 1e6]",
+        ));
+    // A model whose count is wrong: the cause (from the embedding crate) appears once.
+    let mut model = crate::common::small_model(1).to_model();
+    model.control_points.pop();
+    let path = dir.path().join("short.json");
+    std::fs::write(&path, serde_json::to_string(&model).unwrap()).unwrap();
+    let out = ntori()
+        .arg("export")
+        .arg(&path)
+        .arg("-o")
+        .arg(dir.path().join("m.obj"))
+        .assert()
+        .code(1)
+        .get_output()
+        .stderr
+        .clone();
+    let text = String::from_utf8(out).unwrap();
+    assert_eq!(
+        text.matches("control points, its settings need").count(),
+        1,
+        "{text}"
+    );
+    // Log lines to a pipe carry no colour codes.
+    let out = ntori()
+        .args([
+            "-v",
+            "tessellate",
+            "-g",
+            "2",
+            "--te",
+            "1",
+            "--tr",
+            "1",
+            "--svg",
+        ])
+        .arg(dir.path().join("t.svg"))
+        .assert()
+        .success()
+        .get_output()
+        .stderr
+        .clone();
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.contains("wrote the drawing"), "{text}");
+    assert!(!text.contains('\u{1b}'), "escape codes in {text:?}");
+}
+
+#[test]
+fn render_without_a_runtime_directory_prints_nothing_when_quiet() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = scaled_model(dir.path(), "m.json", 1.0, None);
+    ntori()
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .arg("render")
+        .arg(&model)
+        .args(["--size", "64x48", "--tessellation", "4", "-q", "-o"])
+        .arg(dir.path().join("m.png"))
+        .assert()
+        .success()
+        .stdout("")
+        .stderr("");
+}

@@ -546,7 +546,7 @@ fn formats_come_from_extensions() {
 fn model_files_round_trip_and_report_what_is_wrong() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.json");
-    model_file::save(&path, &models()[1]).unwrap();
+    model_file::save(&path, models()[1]).unwrap();
     assert_eq!(model_file::load(&path).unwrap(), *models()[1]);
 
     let text = std::fs::read_to_string(&path).unwrap();
@@ -583,7 +583,7 @@ fn model_files_round_trip_and_report_what_is_wrong() {
 
     // Saving into a directory that does not exist fails and leaves nothing behind.
     let nowhere = dir.path().join("no/such/dir/m.json");
-    assert!(model_file::save(&nowhere, &models()[1]).is_err());
+    assert!(model_file::save(&nowhere, models()[1]).is_err());
     assert!(!nowhere.exists());
 }
 
