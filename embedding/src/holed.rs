@@ -375,7 +375,7 @@ impl HoledMesh {
             1 => Plan::torus(h),
             n => Plan::plate(n, h),
         };
-        build(&plan, h, genus)
+        build(&plan, h, genus, resolution)
     }
 }
 
@@ -385,7 +385,7 @@ fn key(p: P2) -> (u64, u64) {
 }
 
 /// Meshes the plan in the plane (constrained Delaunay, refined) and lifts it.
-fn build(plan: &Plan, h: f64, genus: u32) -> Result<HoledMesh, EmbeddingError> {
+fn build(plan: &Plan, h: f64, genus: u32, resolution: usize) -> Result<HoledMesh, EmbeddingError> {
     let fail = |what: String| EmbeddingError::Parameterization(what);
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
     let mut handles = HashMap::new();
@@ -428,10 +428,19 @@ fn build(plan: &Plan, h: f64, genus: u32) -> Result<HoledMesh, EmbeddingError> {
             .keep_constraint_edges()
             .with_angle_limit(spade::AngleLimit::from_deg(20.0))
             .with_max_allowed_area(1.5 * area)
-            .with_max_additional_vertices(20_000_000),
+            // The lifted mesh has about four triangles per plan vertex, so a mesh the fit takes
+            // never needs more; this bounds the meshing's own memory for resolutions it refuses.
+            .with_max_additional_vertices(crate::fit::MAX_FIT_TRIANGLES),
     );
     if !result.refinement_complete {
-        return Err(fail("the plan could not be meshed finely enough".into()));
+        return Err(EmbeddingError::FitTooLarge {
+            genus,
+            resolution,
+            // Top and bottom faces: twice the plan's triangles, and more to come.
+            triangles: 2 * cdt.num_inner_faces(),
+            at_least: true,
+            max: crate::fit::MAX_FIT_TRIANGLES,
+        });
     }
     // Refinement may have flipped edges into dividing position again.
     split_dividing_edges(plan, &mut cdt, &handles)?;

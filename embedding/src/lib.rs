@@ -67,6 +67,20 @@ pub enum EmbeddingError {
     BadTarget(usize),
     #[error("the edit's constraints could not be solved")]
     Unsolvable,
+    #[error(
+        "genus {genus} at mesh resolution {resolution} makes {}{triangles} input triangles, which would take about {:.1} GB to fit ({} bytes a triangle, measured); the fit takes at most {max} triangles: lower the resolution",
+        if *.at_least { "more than " } else { "" },
+        *.triangles as f64 * fit::FIT_BYTES_PER_TRIANGLE as f64 / 1e9,
+        fit::FIT_BYTES_PER_TRIANGLE
+    )]
+    FitTooLarge {
+        genus: u32,
+        resolution: usize,
+        triangles: usize,
+        /// The count is where meshing stopped: the mesh would have more.
+        at_least: bool,
+        max: usize,
+    },
     #[error("cannot parameterize the mesh: {0}")]
     Parameterization(String),
     #[error(transparent)]

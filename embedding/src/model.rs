@@ -10,7 +10,9 @@ pub const MODEL_FORMAT: &str = "ntori-model";
 pub const MODEL_VERSION: u32 = 1;
 
 /// A surface: genus, spline settings and every chart's control points (in [`Layout`] order).
+/// Unknown fields are refused: a misspelt field would otherwise be ignored without a word.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Model {
     pub format: String,
     pub version: u32,

@@ -152,6 +152,17 @@ impl Surface {
         crate::fit::diagonal(&self.control)
     }
 
+    /// Whether the surface has no extent to speak of: its control points coincide (to 1e-12 of their
+    /// magnitude), so no point of it has a normal. Export and rendering refuse such a surface.
+    pub fn is_degenerate(&self) -> bool {
+        let size = self.control_net_size();
+        let largest = self
+            .control
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p.coords.amax()));
+        size.is_nan() || size <= 1e-12 * largest
+    }
+
     fn check_points(&self, control: &[Point3]) -> Result<(), EmbeddingError> {
         let expected = self.atlas.charts().len() * self.settings.grid * self.settings.grid;
         if control.len() != expected {

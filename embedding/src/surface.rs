@@ -33,6 +33,7 @@ pub fn bounding_box(points: &[Point3]) -> (Point3, Point3) {
 
 /// The spline and blend parameters of a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SplineSettings {
     /// Degree of the spline patches (3: cubic).
     pub degree: usize,

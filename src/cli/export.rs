@@ -84,14 +84,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         Encoding::Binary
     };
-    if let (Ok(a), Ok(b)) = (model_path.canonicalize(), output.canonicalize())
-        && a == b
-    {
-        anyhow::bail!(
-            "{} is the model file; writing the mesh there would destroy the model",
-            output.display()
-        );
-    }
+    ntori::io::atomic::check_output(output, &[&model_path])?;
     let model = ntori::io::model_file::load(&model_path)?;
     export::check_resolution(model.genus(), te, tr)?;
     let exported = export::export_surface(&model, (te, tr), output, format, encoding).map_err(

@@ -65,9 +65,23 @@ struct GenusArg {
         long,
         default_value_t = 2,
         value_name = "N",
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = parse_genus
     )]
     genus: u32,
+}
+
+/// A genus: a whole number 0 or more. (Above 64 the charts say "not supported" with the limit;
+/// clap's own u32 parser would answer -1 with the range 0..=4294967295.)
+fn parse_genus(s: &str) -> Result<u32, String> {
+    let max = charts::MAX_GENUS;
+    match s.trim().parse::<i64>() {
+        Ok(n) if n < 0 => Err(format!("a genus is 0 or more (0 to {max}), got {n}")),
+        Ok(n) => u32::try_from(n).map_err(|_| format!("genus {n} is not supported (0 to {max})")),
+        Err(_) => Err(format!(
+            "a genus is a whole number from 0 to {max}, got {s:?}"
+        )),
+    }
 }
 
 /// Writes to stdout; a closed pipe (`ntori info | head`) is not an error.

@@ -56,7 +56,8 @@ pub struct Args {
           value_parser = clap::value_parser!(u64).range(1..=4))]
     continuity: u64,
     /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term).
-    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ")]
+    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ",
+          value_parser = parse_smoothness)]
     smoothness: f64,
     /// Print the report as JSON.
     #[arg(long)]
@@ -79,11 +80,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         quiet,
     } = args;
-    if output.exists() && !force {
-        anyhow::bail!(
-            "{} exists; pass --force to replace it, or -o to write elsewhere",
-            output.display()
-        );
+    // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
+    // special file, and without --force it does not exist yet.
+    let target = ntori::io::atomic::check_output(&output, &[])?;
+    if !force && std::fs::symlink_metadata(&target).is_ok() {
+        return Err(ntori::io::atomic::FileError::Exists { path: output }.into());
     }
     let settings = SplineSettings {
         degree: degree as usize,
@@ -101,7 +102,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     });
     bar.finish_and_clear();
     let (model, report) = made.with_context(|| format!("cannot make a genus-{genus} model"))?;
-    ntori::io::model_file::save(&output, &model)?;
+    if force {
+        ntori::io::model_file::save(&output, &model)?;
+    } else {
+        // Exclusive: a file created at the output during the fit is kept, not replaced.
+        ntori::io::model_file::save_new(&output, &model)?;
+    }
     emit(
         &Written {
             report: &report,
@@ -113,6 +119,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
 /// The report once the model is saved: as text it also says where the model went; as JSON it is
 /// the report alone.
+/// The largest smoothness weight accepted: beyond it the least-squares system is the smoothness
+/// term alone to f64 precision (λ = 1e308 overflowed into non-finite control points).
+const MAX_SMOOTHNESS: f64 = 1e6;
+
+/// λ: a number in (0, 1e6].
+fn parse_smoothness(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v > 0.0 && v <= MAX_SMOOTHNESS {
+        Ok(v)
+    } else {
+        Err(format!(
+            "the smoothness weight must lie in (0, {MAX_SMOOTHNESS:e}], got {v}"
+        ))
+    }
+}
+
 #[derive(Serialize)]
 #[serde(transparent)]
 struct Written<'a> {

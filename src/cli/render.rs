@@ -98,6 +98,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         style,
         tessellation,
     };
+    ntori::io::atomic::check_output(&output, &[&model])?;
     let loaded = ntori::io::model_file::load(&model)?;
     let bar = spinner(quiet);
     bar.set_message("opening the graphics adapter");

@@ -13,7 +13,7 @@ use super::mesh::LiveMesh;
 use crate::render::gpu::{
     FrameBinding, FrameUniforms, PipelineSpec, Targets, buffer_entry, pipeline, pipeline_layout,
 };
-use crate::render::{Image, RenderError};
+use crate::render::{Image, RenderError, check_buffer};
 
 /// The colour format egui accepts for native textures.
 pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -108,18 +108,21 @@ impl ViewportRenderer {
 
     /// Brings the GPU's copy of the mesh up to date: new buffers after a new tessellation, else
     /// only the vertex ranges that changed; and the drag in progress (its rows once per drag, the
-    /// displacement every time). Returns whether anything the picture depends on changed.
+    /// displacement every time). Returns whether anything the picture depends on changed, or,
+    /// where a buffer would exceed the device's limits, an error naming the limit (nothing of that
+    /// size is allocated, and no mesh is drawn until a smaller one comes).
     pub fn sync(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         mesh: &mut LiveMesh,
         drag: Option<(u64, &[DragRow], Vector3)>,
-    ) -> bool {
+    ) -> Result<bool, RenderError> {
         let mut new_group = false;
         if let Some((id, rows, _)) = drag
             && id != self.drag_id
         {
+            check_buffer(&device.limits(), "drag's row buffer", byte_size(rows), true)?;
             self.drag_rows = drag_buffer(device, rows);
             self.drag_id = id;
             self.last_drag_upload = std::mem::size_of_val(rows);
@@ -144,7 +147,9 @@ impl ViewportRenderer {
         self.last_upload = match written {
             Some(bytes) => bytes,
             None => {
-                self.mesh = Some(self.upload(device, mesh));
+                // Dropped first: a mesh that cannot be uploaded leaves nothing stale drawn.
+                self.mesh = None;
+                self.mesh = Some(self.upload(device, mesh)?);
                 std::mem::size_of_val(mesh.vertices()) + 4 * mesh.indices().len()
             }
         };
@@ -161,11 +166,20 @@ impl ViewportRenderer {
                 &self.drag_uniform,
             );
         }
-        new_group || moved || written != Some(0)
+        Ok(new_group || moved || written != Some(0))
     }
 
-    fn upload(&self, device: &wgpu::Device, mesh: &LiveMesh) -> MeshBuffers {
+    fn upload(&self, device: &wgpu::Device, mesh: &LiveMesh) -> Result<MeshBuffers, RenderError> {
         use wgpu::util::DeviceExt as _;
+        let limits = device.limits();
+        let vertex_bytes = byte_size(mesh.vertices());
+        check_buffer(&limits, "editor's vertex buffer", vertex_bytes, true)?;
+        check_buffer(
+            &limits,
+            "editor's index buffer",
+            byte_size(mesh.indices()),
+            true,
+        )?;
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ntori editor vertices"),
             contents: bytemuck::cast_slice(&nonempty(mesh.vertices())),
@@ -184,13 +198,14 @@ impl ViewportRenderer {
             &self.drag_rows,
             &self.drag_uniform,
         );
-        MeshBuffers {
+        Ok(MeshBuffers {
             vertices,
             _indices: indices,
             vertex_count: mesh.vertex_count(),
+            // At most MAX_SCENE_BUFFER / 4 indices (checked above): fits a u32.
             index_count: mesh.indices().len() as u32,
             group,
-        }
+        })
     }
 
     /// Draws the mesh into the targets (made anew when the size changed; see
@@ -291,6 +306,11 @@ fn drag_buffer(device: &wgpu::Device, rows: &[DragRow]) -> wgpu::Buffer {
         contents: bytemuck::cast_slice(&nonempty(rows)),
         usage: wgpu::BufferUsages::STORAGE,
     })
+}
+
+/// The bytes a slice takes, as the limits count them.
+fn byte_size<T>(data: &[T]) -> u64 {
+    u64::try_from(std::mem::size_of_val(data)).unwrap_or(u64::MAX)
 }
 
 /// wgpu refuses empty buffers bound as storage: give it one zero element.

@@ -260,7 +260,22 @@ impl Viewport {
         let gpu = self
             .gpu
             .get_or_insert_with(|| ViewportRenderer::new(&rs.device));
-        let changed = state.with_display(|mesh, drag| gpu.sync(&rs.device, &rs.queue, mesh, drag));
+        let changed =
+            match state.with_display(|mesh, drag| gpu.sync(&rs.device, &rs.queue, mesh, drag)) {
+                Ok(changed) => changed,
+                Err(e) => {
+                    // A mesh too large for this GPU: say so where the picture would be.
+                    painter.rect_filled(rect, 0.0, background());
+                    painter.text(
+                        rect.center(),
+                        Align2::CENTER_CENTER,
+                        format!("Cannot draw this mesh: {e}"),
+                        FontId::proportional(15.0),
+                        Color32::LIGHT_GRAY,
+                    );
+                    return;
+                }
+            };
         let uniforms = state.camera.uniforms(state.style(), size_px);
         let key = (bytemuck::bytes_of(&uniforms).to_vec(), size_px);
         if changed || self.last_drawn.as_ref() != Some(&key) || gpu.texture_view().is_none() {

@@ -8,9 +8,16 @@
 use std::path::{Path, PathBuf};
 
 use embedding::{EmbeddingError, Model, ModelHeader, Surface};
-use serde::Deserialize as _;
 
-use crate::io::atomic::{FileError, write_atomically};
+use crate::io::atomic::{FileError, write_atomically, write_new_with};
+
+/// The largest model file read, in bytes. A model of genus 64 with 64×64 control grids (the
+/// largest `ntori new` makes) is about 40 MB; a larger file is refused before it is read, so a
+/// mistaken path (`/dev/zero`, a huge log) cannot exhaust the memory.
+pub const MAX_MODEL_BYTES: u64 = 256 << 20;
+
+/// The longest piece of a file quoted in an error message (a 10 MB string is not echoed whole).
+const MAX_QUOTE: usize = 60;
 
 /// Why a model file could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -22,11 +29,15 @@ pub enum ModelFileError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{} is not a JSON file: {source}", .path.display())]
-    NotJson {
-        path: PathBuf,
-        source: serde_json::Error,
-    },
+    #[error("cannot read {}: it is a {kind}, not a regular file", .path.display())]
+    NotRegular { path: PathBuf, kind: &'static str },
+    #[error(
+        "cannot read {}: it has {size} bytes or more, and a model file may have at most {max}",
+        .path.display()
+    )]
+    TooLarge { path: PathBuf, size: u64, max: u64 },
+    #[error("{} is not a JSON file: {reason}", .path.display())]
+    NotJson { path: PathBuf, reason: String },
     #[error("{} is not an ntori model: {reason}", .path.display())]
     NotAModel { path: PathBuf, reason: String },
     #[error(
@@ -53,32 +64,32 @@ pub enum ModelFileError {
 }
 
 /// Reads and checks a model file: the surface it holds, validated once and for all.
+///
+/// Only regular files of at most [`MAX_MODEL_BYTES`] are read (a FIFO would block, a device never
+/// end). The JSON is parsed straight into the model (no intermediate tree, so memory stays a small
+/// multiple of the file); unknown fields, duplicate keys and version 0 are refused, and a wrong
+/// value is reported with its place, e.g. `control_points[17].y`.
 pub fn load(path: impl AsRef<Path>) -> Result<Surface, ModelFileError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| match source.kind() {
-        std::io::ErrorKind::NotFound => ModelFileError::Missing {
-            path: path.to_owned(),
-        },
-        _ => ModelFileError::Unreadable {
-            path: path.to_owned(),
-            source,
-        },
-    })?;
-    let value: serde_json::Value =
-        serde_json::from_slice(&bytes).map_err(|source| ModelFileError::NotJson {
-            path: path.to_owned(),
-            source,
-        })?;
+    let bytes = read_capped(path)?;
     let not_a_model = |reason: String| ModelFileError::NotAModel {
         path: path.to_owned(),
         reason,
     };
-    if !value.is_object() {
+    // Syntax first (without building anything), so a broken file is "not JSON", not "not a model".
+    serde_json::from_slice::<serde::de::IgnoredAny>(&bytes).map_err(|e| {
+        ModelFileError::NotJson {
+            path: path.to_owned(),
+            reason: describe(&e, None),
+        }
+    })?;
+    if bytes.iter().find(|b| !b.is_ascii_whitespace()) != Some(&b'{') {
         return Err(not_a_model("the JSON is not an object".into()));
     }
-    let header = ModelHeader::deserialize(&value).map_err(|e| {
+    let header: ModelHeader = serde_json::from_slice(&bytes).map_err(|e| {
         not_a_model(format!(
-            "it has no valid \"format\" and \"version\" fields ({e})"
+            "it has no valid \"format\" and \"version\" fields ({})",
+            describe(&e, None)
         ))
     })?;
     header.check().map_err(|e| match e {
@@ -88,28 +99,178 @@ pub fn load(path: impl AsRef<Path>) -> Result<Surface, ModelFileError> {
             supported,
         },
         EmbeddingError::NotAModel(format) => not_a_model(format!(
-            "its format is \"{format}\", not \"{}\"",
+            "its format is \"{}\", not \"{}\"",
+            shorten(&format),
             embedding::MODEL_FORMAT
         )),
         other => not_a_model(other.to_string()),
     })?;
-    let model = Model::deserialize(value).map_err(|e| not_a_model(e.to_string()))?;
+    if header.version == 0 {
+        return Err(not_a_model(format!(
+            "its version is 0; model versions start at 1 (this build reads 1 to {})",
+            embedding::MODEL_VERSION
+        )));
+    }
+    let mut de = serde_json::Deserializer::from_slice(&bytes);
+    let model: Model = serde_path_to_error::deserialize(&mut de)
+        .map_err(|e| not_a_model(describe(e.inner(), Some(&field_path(e.path())))))?;
     Surface::from_model(&model).map_err(|source| ModelFileError::Inconsistent {
         path: path.to_owned(),
         source,
     })
 }
 
+/// The file's bytes, if it is a regular file of at most [`MAX_MODEL_BYTES`].
+fn read_capped(path: &Path) -> Result<Vec<u8>, ModelFileError> {
+    use std::io::Read as _;
+    let unreadable = |source: std::io::Error| match source.kind() {
+        std::io::ErrorKind::NotFound => ModelFileError::Missing {
+            path: path.to_owned(),
+        },
+        _ => ModelFileError::Unreadable {
+            path: path.to_owned(),
+            source,
+        },
+    };
+    // Before opening: opening a FIFO blocks until someone writes to it.
+    let meta = std::fs::metadata(path).map_err(unreadable)?;
+    if !meta.is_file() {
+        return Err(ModelFileError::NotRegular {
+            path: path.to_owned(),
+            kind: crate::io::atomic::kind_of(&meta.file_type()),
+        });
+    }
+    let too_large = |size| ModelFileError::TooLarge {
+        path: path.to_owned(),
+        size,
+        max: MAX_MODEL_BYTES,
+    };
+    if meta.len() > MAX_MODEL_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(unreadable)?;
+    // The file may grow after the check: read one byte past the cap at most.
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(MAX_MODEL_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(unreadable)?;
+    if bytes.len() as u64 > MAX_MODEL_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// A serde_json error as one line: the field path where known, the problem with long quotes cut,
+/// and the place in the file.
+fn describe(e: &serde_json::Error, field: Option<&str>) -> String {
+    let text = e.to_string();
+    // serde_json ends its messages with " at line L column C"; say the place once, at the end.
+    let problem = match text.rfind(" at line ") {
+        Some(i) if e.line() > 0 => &text[..i],
+        _ => &text[..],
+    };
+    let problem = shorten_quotes(problem);
+    let place = if e.line() > 0 {
+        format!(" (line {}, column {})", e.line(), e.column())
+    } else {
+        String::new()
+    };
+    match field {
+        Some(field) if !field.is_empty() && field != "." => format!("{field}: {problem}{place}"),
+        _ => format!("{problem}{place}"),
+    }
+}
+
+/// A field path as a user reads it: `control_points[17].y` for the second coordinate of point 17.
+fn field_path(path: &serde_path_to_error::Path) -> String {
+    use serde_path_to_error::Segment;
+    let mut out = String::new();
+    let mut in_points = false;
+    let mut depth = 0;
+    for segment in path.iter() {
+        depth += 1;
+        match segment {
+            Segment::Map { key } => {
+                if !out.is_empty() {
+                    out.push('.');
+                }
+                out.push_str(&shorten(key));
+                in_points = depth == 1 && key == "control_points";
+            }
+            Segment::Seq { index } if in_points && depth == 3 && *index < 3 => {
+                out.push('.');
+                out.push(['x', 'y', 'z'][*index]);
+            }
+            Segment::Seq { index } => out.push_str(&format!("[{index}]")),
+            Segment::Enum { variant } => {
+                out.push('.');
+                out.push_str(&shorten(variant));
+            }
+            Segment::Unknown => out.push_str(".?"),
+        }
+    }
+    out
+}
+
+/// At most [`MAX_QUOTE`] characters of `s`, with "…" and the full length where cut.
+fn shorten(s: &str) -> String {
+    let count = s.chars().count();
+    if count <= MAX_QUOTE {
+        return s.to_owned();
+    }
+    let head: String = s.chars().take(MAX_QUOTE).collect();
+    format!("{head}… ({count} characters)")
+}
+
+/// Every backquoted or double-quoted run in a message shortened (serde echoes the offending
+/// string or key whole).
+fn shorten_quotes(message: &str) -> String {
+    let mut out = String::with_capacity(message.len().min(1024));
+    let mut rest = message;
+    while let Some(open) = rest.find(['"', '`']) {
+        let quote = rest.as_bytes()[open] as char;
+        out.push_str(&rest[..=open]);
+        let after = &rest[open + 1..];
+        match after.find(quote) {
+            Some(close) => {
+                out.push_str(&shorten(&after[..close]));
+                out.push(quote);
+                rest = &after[close + 1..];
+            }
+            None => {
+                out.push_str(&shorten(after));
+                return out;
+            }
+        }
+    }
+    out.push_str(&shorten(rest));
+    out
+}
+
 /// Writes a surface's model file atomically (a file that exists is replaced; callers decide whether
 /// it may).
 pub fn save(path: impl AsRef<Path>, surface: &Surface) -> Result<(), ModelFileError> {
     let path = path.as_ref();
+    let text = model_text(path, surface)?;
+    write_atomically(path, text.as_bytes())?;
+    Ok(())
+}
+
+/// Writes a surface's model file atomically where no file exists: one that appeared meanwhile is
+/// kept and [`FileError::Exists`] returned.
+pub fn save_new(path: impl AsRef<Path>, surface: &Surface) -> Result<(), ModelFileError> {
+    let path = path.as_ref();
+    let text = model_text(path, surface)?;
+    write_new_with(path, |w| w.write_all(text.as_bytes()))?;
+    Ok(())
+}
+
+fn model_text(path: &Path, surface: &Surface) -> Result<String, ModelFileError> {
     let model = surface.to_model();
     let mut text = serde_json::to_string(&model).map_err(|source| ModelFileError::Serialize {
         path: path.to_owned(),
         source,
     })?;
     text.push('\n');
-    write_atomically(path, text.as_bytes())?;
-    Ok(())
+    Ok(text)
 }

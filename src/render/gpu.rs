@@ -71,7 +71,29 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
-    pub fn new(device: &wgpu::Device, vertices: &[SurfaceVertex], segments: &[Segment]) -> Self {
+    /// Uploads the geometry, after checking every buffer against the device's limits (an error
+    /// naming the limit, where wgpu would panic).
+    pub fn new(
+        device: &wgpu::Device,
+        vertices: &[SurfaceVertex],
+        segments: &[Segment],
+    ) -> Result<Self, RenderError> {
+        let limits = device.limits();
+        let size = |bytes: usize| u64::try_from(bytes).unwrap_or(u64::MAX);
+        super::check_buffer(
+            &limits,
+            "surface's vertex buffer",
+            size(std::mem::size_of_val(vertices)),
+            false,
+        )?;
+        super::check_buffer(
+            &limits,
+            "curves' segment buffer",
+            size(std::mem::size_of_val(segments)),
+            false,
+        )?;
+        // Both checked against MAX_SCENE_BUFFER (2 GiB) above, so both counts fit a u32.
+        let vertex_count = vertices.len() as u32;
         let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ntori surface vertices"),
             contents: bytemuck::cast_slice(vertices),
@@ -85,11 +107,11 @@ impl GpuScene {
             });
             (buffer, segments.len() as u32)
         });
-        GpuScene {
+        Ok(GpuScene {
             vertices: vertex_buffer,
-            vertex_count: vertices.len() as u32,
+            vertex_count,
             segments,
-        }
+        })
     }
 
     /// Overwrites the vertices in place (same count), e.g. after an edit.

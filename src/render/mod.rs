@@ -33,6 +33,40 @@ pub enum RenderError {
     View(String),
     #[error("the mesh cannot be drawn: {0}")]
     Mesh(String),
+    #[error(
+        "the {what} would take {bytes} bytes, more than {limit} bytes ({limit_name}); use a smaller tessellation"
+    )]
+    BufferTooLarge {
+        what: &'static str,
+        bytes: u64,
+        limit: u64,
+        /// Which limit: the device's, or ntori's own cap on a scene's memory.
+        limit_name: &'static str,
+    },
+    #[error(
+        "genus {genus} at a tessellation of {t} makes {triangles} triangles; a picture may have at most {max}: use a smaller tessellation"
+    )]
+    TooManyTriangles {
+        genus: u32,
+        t: u32,
+        triangles: u64,
+        max: u64,
+    },
+    #[error("the surface is degenerate: its control points coincide, so it has no area to draw")]
+    Degenerate,
+    #[error(
+        "vertex {index} lies at ({x:e}, {y:e}, {z:e}), beyond the 32-bit floats the GPU draws with (±3.4e38); scale the model down"
+    )]
+    NotDrawable {
+        index: usize,
+        x: f64,
+        y: f64,
+        z: f64,
+    },
+    #[error(
+        "the surface spans {extent:e}, below what the GPU's 32-bit floats can tell apart: it would be drawn as one point; scale the model up"
+    )]
+    Collapses { extent: f64 },
     #[error("reading the image back from the GPU failed: {0}")]
     Readback(String),
     #[error("the PNG could not be encoded: {0}")]
@@ -158,6 +192,80 @@ const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const SAMPLES: u32 = 4;
 /// The largest picture side accepted.
 pub const MAX_SIDE: u32 = 8192;
+/// The most triangles a picture may have. Building the scene holds about 740 bytes a triangle on
+/// the CPU (measured: genus 1 at t = 256, 1 308 672 triangles, peaks at 967 MB: the tessellation,
+/// the evaluated corners, the vertex buffer's copy), so this bounds the renderer near 3 GB. The
+/// command line's cases that failed on wgpu's default limits (genus 2 at t = 255, genus 8 at 128,
+/// genus 64 at 40) are all below it.
+pub const MAX_TRIANGLES: u64 = 4_000_000;
+/// The most bytes one buffer of a scene may take, whatever the device allows: the CPU holds a copy
+/// of it (and more) while the scene is built, so this also bounds the renderer's memory.
+pub const MAX_SCENE_BUFFER: u64 = 2 << 30;
+
+/// Refuses a buffer of `bytes` that the device (`limits`) could not hold, or that is larger than
+/// [`MAX_SCENE_BUFFER`]; `storage` for buffers bound as storage (their binding has its own limit).
+/// Called before anything of that size is allocated, so an impossible request is an error rather
+/// than wgpu's panic.
+pub fn check_buffer(
+    limits: &wgpu::Limits,
+    what: &'static str,
+    bytes: u64,
+    storage: bool,
+) -> Result<(), RenderError> {
+    let mut checks = vec![
+        (
+            limits.max_buffer_size,
+            "the graphics device's max_buffer_size",
+        ),
+        (MAX_SCENE_BUFFER, "ntori's cap on one scene buffer"),
+    ];
+    if storage {
+        checks.push((
+            limits.max_storage_buffer_binding_size,
+            "the graphics device's max_storage_buffer_binding_size",
+        ));
+    }
+    match checks.into_iter().filter(|&(limit, _)| bytes > limit).min() {
+        Some((limit, limit_name)) => Err(RenderError::BufferTooLarge {
+            what,
+            bytes,
+            limit,
+            limit_name,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Opens a device on the first adapter wgpu finds, with the adapter's own buffer limits (wgpu's
+/// defaults are far below what most adapters allow), capped at `max_buffer_size` where given.
+/// Returns the device, its queue and the adapter's name.
+pub fn open_device(
+    max_buffer_size: Option<u64>,
+) -> Result<(wgpu::Device, wgpu::Queue, String), RenderError> {
+    // Vulkan (or Metal, DX12) first: probing OpenGL through EGL without a display only prints
+    // errors. OpenGL is the fallback where nothing else exists.
+    let adapter = request_adapter(wgpu::Backends::PRIMARY)
+        .or_else(|_| request_adapter(wgpu::Backends::all()))?;
+    let adapter_name = adapter.get_info().name;
+    let available = adapter.limits();
+    let mut limits = wgpu::Limits::downlevel_defaults().using_resolution(available.clone());
+    limits.max_buffer_size = available.max_buffer_size;
+    limits.max_storage_buffer_binding_size = available.max_storage_buffer_binding_size;
+    if let Some(cap) = max_buffer_size {
+        limits.max_buffer_size = limits.max_buffer_size.min(cap);
+        limits.max_storage_buffer_binding_size = limits.max_storage_buffer_binding_size.min(cap);
+    }
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("ntori offscreen"),
+        required_features: wgpu::Features::empty(),
+        required_limits: limits,
+        experimental_features: Default::default(),
+        memory_hints: wgpu::MemoryHints::MemoryUsage,
+        trace: Default::default(),
+    }))
+    .map_err(|e| RenderError::Device(e.to_string()))?;
+    Ok((device, queue, adapter_name))
+}
 
 fn request_adapter(backends: wgpu::Backends) -> Result<wgpu::Adapter, RenderError> {
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
@@ -184,20 +292,13 @@ pub struct Offscreen {
 impl Offscreen {
     /// Opens the first adapter wgpu finds (a GPU, or Mesa's lavapipe on a machine without one).
     pub fn new() -> Result<Offscreen, RenderError> {
-        // Vulkan (or Metal, DX12) first: probing OpenGL through EGL without a display only prints
-        // errors. OpenGL is the fallback where nothing else exists.
-        let adapter = request_adapter(wgpu::Backends::PRIMARY)
-            .or_else(|_| request_adapter(wgpu::Backends::all()))?;
-        let adapter_name = adapter.get_info().name;
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("ntori offscreen"),
-            required_features: wgpu::Features::empty(),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
-            experimental_features: Default::default(),
-            memory_hints: wgpu::MemoryHints::MemoryUsage,
-            trace: Default::default(),
-        }))
-        .map_err(|e| RenderError::Device(e.to_string()))?;
+        Offscreen::with_max_buffer_size(None)
+    }
+
+    /// Like [`Offscreen::new`], with no buffer larger than `max_buffer_size` bytes where given (to
+    /// leave GPU memory to others, or to test what happens at the limit).
+    pub fn with_max_buffer_size(max_buffer_size: Option<u64>) -> Result<Offscreen, RenderError> {
+        let (device, queue, adapter_name) = open_device(max_buffer_size)?;
         let renderer = SurfaceRenderer::new(&device, OFFSCREEN_FORMAT, SAMPLES);
         tracing::info!(adapter = %adapter_name, "offscreen renderer ready");
         Ok(Offscreen {
@@ -231,6 +332,25 @@ impl Offscreen {
         curves: &[Curve],
     ) -> Result<Image, RenderError> {
         self.check(options)?;
+        // The scene's size is known in closed form: refuse it before tessellating anything.
+        let t = options.tessellation;
+        let corners = 3 * charts::Tessellation::expected_triangles(model.genus(), t, t);
+        let bytes = corners.saturating_mul(std::mem::size_of::<gpu::SurfaceVertex>() as u64);
+        check_buffer(
+            &self.device.limits(),
+            "surface's vertex buffer",
+            bytes,
+            false,
+        )?;
+        let triangles = corners / 3;
+        if triangles > MAX_TRIANGLES {
+            return Err(RenderError::TooManyTriangles {
+                genus: model.genus(),
+                t,
+                triangles,
+                max: MAX_TRIANGLES,
+            });
+        }
         let geometry = scene::model_geometry(model, options.tessellation, options.style, curves)?;
         self.draw(&geometry, options)
     }
@@ -271,7 +391,7 @@ impl Offscreen {
             view: options.view,
             aspect: width as f32 / height as f32,
         };
-        let scene = GpuScene::new(&self.device, &geometry.vertices, &geometry.segments);
+        let scene = GpuScene::new(&self.device, &geometry.vertices, &geometry.segments)?;
         let mut frame = camera.uniforms(options.style, (width, height));
         if geometry.legend.is_some() {
             // Leave room at the right for the legend.

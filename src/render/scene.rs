@@ -41,6 +41,10 @@ pub fn model_geometry(
     style: Style,
     curves: &[Curve],
 ) -> Result<SceneGeometry, RenderError> {
+    // What export refuses, a picture refuses too (rather than a blank PNG and exit 0).
+    if surface.is_degenerate() {
+        return Err(RenderError::Degenerate);
+    }
     let atlas = surface.atlas();
     let tess = atlas.tessellate(t, t)?;
     let wants = Wants {
@@ -64,6 +68,7 @@ pub fn model_geometry(
         }
         corners.push((s.position.into(), normal.into(), colour));
     });
+    check_drawable(&corners)?;
     let mut legend = None;
     if let Style::Curvature(kind) = style {
         let range = robust_range(&values);
@@ -76,6 +81,33 @@ pub fn model_geometry(
     geometry.segments = segments(curves);
     geometry.legend = legend;
     Ok(geometry)
+}
+
+/// Refuses positions the GPU's f32 cannot hold (beyond ±3.4e38 they become infinite and the picture
+/// blank), and a surface so small that f32 rounds it to one point.
+fn check_drawable(corners: &[([f64; 3], [f64; 3], [f32; 3])]) -> Result<(), RenderError> {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for (index, (p, _, _)) in corners.iter().enumerate() {
+        let q = p.map(|x| x as f32);
+        if !q.iter().all(|x| x.is_finite()) {
+            let [x, y, z] = *p;
+            return Err(RenderError::NotDrawable { index, x, y, z });
+        }
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k]);
+            hi[k] = hi[k].max(q[k]);
+        }
+    }
+    if !corners.is_empty() && (0..3).all(|k| lo[k] == hi[k]) {
+        let extent = corners.iter().map(|c| glam::DVec3::from(c.0)).fold(
+            (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
+            |(l, h), p| (l.min(p), h.max(p)),
+        );
+        return Err(RenderError::Collapses {
+            extent: (extent.1 - extent.0).length(),
+        });
+    }
+    Ok(())
 }
 
 /// A plain triangle mesh, flat shaded (face normals) in the surface colour.

@@ -187,7 +187,7 @@ fn errors_name_the_file_and_leave_nothing_behind() {
             "--format".as_ref(),
             "obj".as_ref(),
         ],
-        "is the model file",
+        "it is the input",
         dir.path(),
     );
     assert_eq!(std::fs::read_to_string(&model).unwrap(), model_text());

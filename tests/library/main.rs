@@ -8,5 +8,6 @@ mod assets;
 mod export;
 mod figures;
 mod fit;
+mod hardening;
 mod render;
 mod tessellation;

@@ -167,6 +167,20 @@ pub enum ExportError {
     UnknownFormat { path: PathBuf },
     #[error("{0} has no text and binary variants; --ascii applies to PLY and STL only")]
     NoEncodings(Format),
+    #[error(
+        "vertex {index} lies at ({x:e}, {y:e}, {z:e}), beyond the 32-bit floats {format} stores (±3.4e38); scale the model down"
+    )]
+    NotStorable {
+        format: Format,
+        index: usize,
+        x: f64,
+        y: f64,
+        z: f64,
+    },
+    #[error(
+        "the surface spans {extent:e}, below what the 32-bit floats {format} stores can tell apart: every vertex would be written at the same point; scale the model up"
+    )]
+    Collapses { format: Format, extent: f64 },
     #[error("the mesh needs {0} bytes of GLB, over the format's limit of 4 GiB")]
     GlbTooLarge(u64),
     #[error(transparent)]
@@ -200,10 +214,7 @@ pub fn surface_mesh(surface: &Surface, te: u32, tr: u32) -> Result<SurfaceMesh, 
     // no surface at all.
     let size = surface.control_net_size();
     let control = surface.control_points();
-    let largest = control
-        .iter()
-        .fold(0.0f64, |m, p| m.max(p.coords.abs().max()));
-    if size.is_nan() || size <= 1e-12 * largest {
+    if surface.is_degenerate() {
         let p = control.first().copied().unwrap_or_default();
         return Err(ExportError::Degenerate {
             count: Tessellation::expected_vertices(genus, te, tr) as usize,
@@ -358,9 +369,72 @@ impl SurfaceMesh {
             .count()
     }
 
-    /// The unit normal of triangle `t` from its winding (outward), for STL.
+    /// Checks that every number `format` stores survives its 32-bit floats: positions within the
+    /// f32 range (beyond it they would be written as `inf`, and GLB bounds as `null`), the surface
+    /// not collapsed to one point (a model scaled to 1e-46 rounds to all zeros), and normals,
+    /// STL's face normals among them, finite.
+    pub fn check_storable(&self, format: Format) -> Result<(), ExportError> {
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for i in 0..self.positions.len() {
+            let p = self.position_f32(i);
+            if !p.iter().all(|x| x.is_finite()) {
+                let q = self.positions[i];
+                return Err(ExportError::NotStorable {
+                    format,
+                    index: i,
+                    x: q.x,
+                    y: q.y,
+                    z: q.z,
+                });
+            }
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        if !self.positions.is_empty() && (0..3).all(|k| lo[k] == hi[k]) {
+            let (plo, phi) = embedding::bounding_box(&self.positions);
+            let extent = (phi - plo).norm();
+            return Err(ExportError::Collapses { format, extent });
+        }
+        let degenerate = |count, i: usize| {
+            let q = self.positions[i];
+            ExportError::Degenerate {
+                count,
+                x: q.x,
+                y: q.y,
+                z: q.z,
+            }
+        };
+        let bad_normals: Vec<usize> = (0..self.normals.len())
+            .filter(|&i| !self.normal_f32(i).iter().all(|x| x.is_finite()))
+            .collect();
+        if let Some(&first) = bad_normals.first() {
+            return Err(degenerate(bad_normals.len(), first));
+        }
+        if format == Format::Stl {
+            let bad: Vec<usize> = (0..self.triangles.len())
+                .filter(|&t| !self.face_normal(t).iter().all(|x| (*x as f32).is_finite()))
+                .collect();
+            if let Some(&first) = bad.first() {
+                return Err(degenerate(bad.len(), self.triangles[first][0] as usize));
+            }
+        }
+        Ok(())
+    }
+
+    /// The unit normal of triangle `t` from its winding (outward), for STL. The edges are scaled
+    /// to their largest coordinate first, so far-off or huge coordinates (1e155) do not overflow
+    /// the cross product into a NaN normal.
     pub fn face_normal(&self, t: usize) -> Vector3 {
-        let n = face_normal(&self.positions, &self.triangles[t]).normalize();
+        let [a, b, c] = self.triangles[t].map(|i| self.positions[i as usize]);
+        let (e1, e2) = (b - a, c - a);
+        let scale = e1.amax().max(e2.amax());
+        let n = if scale > 0.0 && scale.is_finite() {
+            (e1 / scale).cross(&(e2 / scale)).normalize()
+        } else {
+            Vector3::repeat(f64::NAN)
+        };
         if n.iter().all(|x| x.is_finite()) {
             n
         } else {
@@ -408,6 +482,7 @@ pub fn write(
     format: Format,
     encoding: Encoding,
 ) -> Result<(), ExportError> {
+    mesh.check_storable(format)?;
     if format == Format::Glb {
         glb::glb_size(mesh)?;
     }

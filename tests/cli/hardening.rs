@@ -1,0 +1,550 @@
+//! Hardening (issue 16): what a careless or hostile user types gets a clear error and a non-zero
+//! exit, never a panic (exit 101), a hang, or a destroyed file.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use embedding::{Model, Surface};
+use predicates::prelude::*;
+
+use crate::common::ntori;
+
+/// A model file of `genus` whose every control point is the origin (cheap at any genus: no fit).
+fn constant_model(dir: &Path, genus: u32) -> std::path::PathBuf {
+    let atlas = Arc::new(charts::Atlas::new(genus).unwrap());
+    let settings = embedding::SplineSettings {
+        grid: 8,
+        ..Default::default()
+    };
+    let layout = embedding::Layout::new(&atlas, settings).unwrap();
+    let model = Model::constant(&layout, embedding::Point3::origin());
+    Surface::from_model(&model).unwrap();
+    let path = dir.join(format!("constant-{genus}.json"));
+    std::fs::write(&path, serde_json::to_string(&model).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn render_refuses_a_tessellation_beyond_the_buffer_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = constant_model(dir.path(), 64);
+    let png = dir.path().join("m.png");
+    // Genus 64 at T = 256: 83.8 M triangles, 12 GB of vertices; refused before tessellating.
+    ntori()
+        .arg("render")
+        .arg(&model)
+        .args(["--tessellation", "256", "-q", "-o"])
+        .arg(&png)
+        .timeout(std::time::Duration::from_secs(600))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "vertex buffer would take 12060721152 bytes",
+        ))
+        .stderr(predicate::str::contains("panicked").not());
+    assert!(!png.exists());
+}
+
+/// A FIFO at `path` (through mkfifo(1), which every Unix has).
+fn mkfifo(path: &Path) {
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+fn is_fifo(path: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt as _;
+    std::fs::symlink_metadata(path)
+        .unwrap()
+        .file_type()
+        .is_fifo()
+}
+
+#[test]
+fn outputs_never_overwrite_an_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = constant_model(dir.path(), 1);
+    let before = std::fs::read(&model).unwrap();
+    let link = dir.path().join("link.json");
+    std::os::unix::fs::symlink(&model, &link).unwrap();
+    for out in [&model, &link] {
+        ntori()
+            .arg("render")
+            .arg(&model)
+            .args(["--tessellation", "2", "-q", "-o"])
+            .arg(out)
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains("it is the input"))
+            .stderr(predicate::str::contains(model.display().to_string()));
+        ntori()
+            .arg("export")
+            .arg(&model)
+            .args(["--format", "obj", "-o"])
+            .arg(out)
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains("it is the input"));
+    }
+    assert_eq!(std::fs::read(&model).unwrap(), before);
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+}
+
+#[test]
+fn special_files_are_refused_as_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = constant_model(dir.path(), 1);
+    let fifo = dir.path().join("fifo");
+    mkfifo(&fifo);
+    let subdir = dir.path().join("sub");
+    std::fs::create_dir(&subdir).unwrap();
+    let link_to_fifo = dir.path().join("to-fifo.obj");
+    std::os::unix::fs::symlink(&fifo, &link_to_fifo).unwrap();
+    for (out, kind) in [
+        (&fifo, "FIFO"),
+        (&subdir, "directory"),
+        (&link_to_fifo, "FIFO"),
+    ] {
+        let runs: [Vec<std::ffi::OsString>; 4] = [
+            vec![
+                "render".into(),
+                model.clone().into(),
+                "--tessellation".into(),
+                "2".into(),
+            ],
+            vec![
+                "export".into(),
+                model.clone().into(),
+                "--format".into(),
+                "obj".into(),
+            ],
+            vec![
+                "tessellate".into(),
+                "-g".into(),
+                "2".into(),
+                "--svg".into(),
+                out.into(),
+            ],
+            vec![
+                "new".into(),
+                "-g".into(),
+                "1".into(),
+                "--force".into(),
+                "-q".into(),
+            ],
+        ];
+        for mut args in runs {
+            if args[0] != "tessellate" {
+                args.extend(["-o".into(), out.into()]);
+            }
+            ntori()
+                .args(&args)
+                .timeout(std::time::Duration::from_secs(120))
+                .assert()
+                .code(1)
+                .stderr(predicate::str::contains(format!("it is a {kind}")));
+        }
+    }
+    assert!(is_fifo(&fifo));
+    assert!(subdir.is_dir());
+    assert!(
+        std::fs::symlink_metadata(&link_to_fifo)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    // /dev/null is a device: refused, whoever runs the test (as root it would have been replaced).
+    ntori()
+        .args(["tessellate", "-g", "2", "--svg", "/dev/null"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("it is a device"));
+}
+
+#[test]
+fn outputs_write_through_symlinks() {
+    let dir = tempfile::tempdir().unwrap();
+    let real = dir.path().join("real");
+    std::fs::create_dir(&real).unwrap();
+    let target = real.join("drawing.svg");
+    std::fs::write(&target, "old").unwrap();
+    let link = dir.path().join("drawing.svg");
+    // A relative link, resolved against the link's directory.
+    std::os::unix::fs::symlink("real/drawing.svg", &link).unwrap();
+    ntori()
+        .args(["tessellate", "-g", "2", "--te", "1", "--tr", "1", "--svg"])
+        .arg(&link)
+        .assert()
+        .success();
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    let svg = std::fs::read_to_string(&target).unwrap();
+    assert!(svg.contains("<svg"), "{svg}");
+    // A dangling link: its target is created.
+    std::fs::remove_file(&target).unwrap();
+    ntori()
+        .args(["tessellate", "-g", "2", "--te", "1", "--tr", "1", "--svg"])
+        .arg(&link)
+        .assert()
+        .success();
+    assert!(std::fs::read_to_string(&target).unwrap().contains("<svg"));
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+}
+
+#[test]
+fn new_checks_its_output_before_fitting() {
+    let dir = tempfile::tempdir().unwrap();
+    // This fit would take minutes (genus 8, resolution 1024); the missing directory is found first,
+    // so the command ends long before the timeout.
+    let out = dir.path().join("missing").join("m.json");
+    ntori()
+        .args(["new", "-g", "8", "--resolution", "512", "-q", "-o"])
+        .arg(&out)
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("does not exist"))
+        .stderr(predicate::str::contains("missing"));
+    let existing = dir.path().join("m.json");
+    std::fs::write(&existing, "mine").unwrap();
+    ntori()
+        .args(["new", "-g", "8", "--resolution", "512", "-q", "-o"])
+        .arg(&existing)
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("it exists; pass --force"));
+    assert_eq!(std::fs::read_to_string(&existing).unwrap(), "mine");
+}
+
+/// A small valid model's JSON, as a tree to break.
+fn model_json(dir: &Path) -> serde_json::Value {
+    let path = constant_model(dir, 1);
+    let mut value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    // Points that differ, so the surface is not degenerate.
+    for (i, p) in value["control_points"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .enumerate()
+    {
+        p[0] = (i as f64).into();
+    }
+    value
+}
+
+#[test]
+fn bad_model_files_get_one_clear_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = model_json(dir.path());
+    let text = serde_json::to_string(&good).unwrap();
+    let edit = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = good.clone();
+        f(&mut v);
+        serde_json::to_string(&v).unwrap()
+    };
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "null.json",
+            edit(&|v| v["control_points"][17][1] = serde_json::Value::Null),
+            "control_points[17].y: invalid type: null, expected f64 (line 1, column",
+        ),
+        (
+            "unknown.json",
+            edit(&|v| v["colour"] = "red".into()),
+            "unknown field `colour`",
+        ),
+        (
+            "version0.json",
+            edit(&|v| v["version"] = 0.into()),
+            "its version is 0",
+        ),
+        (
+            "duplicate.json",
+            text.replacen("{\"", "{\"genus\":3,\"", 1),
+            "duplicate field `genus`",
+        ),
+        (
+            "huge-string.json",
+            edit(&|v| v["genus"] = "y".repeat(1_000_000).into()),
+            "… (1000000 characters)",
+        ),
+        (
+            "truncated.json",
+            text[..100].to_owned(),
+            "is not a JSON file: invalid number (line 1, column 100)",
+        ),
+    ];
+    for (name, contents, expected) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, contents).unwrap();
+        let out = ntori()
+            .arg("export")
+            .arg(&path)
+            .args(["-o"])
+            .arg(dir.path().join("x.obj"))
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains(expected))
+            .stderr(predicate::str::contains("panicked").not());
+        let stderr = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+        assert!(
+            stderr.len() < 600,
+            "{name}: a short message, got {} bytes",
+            stderr.len()
+        );
+        assert_eq!(
+            stderr.matches(name).count(),
+            1,
+            "{name}: the file once: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn model_inputs_must_be_regular_files_of_bounded_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo.json");
+    mkfifo(&fifo);
+    let out = dir.path().join("x.obj");
+    // Each would block or read forever if opened: refused from the file's type and size alone.
+    for (input, expected) in [
+        (fifo.as_path(), "it is a FIFO"),
+        (Path::new("/dev/zero"), "it is a device"),
+        (dir.path(), "it is a directory"),
+    ] {
+        ntori()
+            .arg("export")
+            .arg(input)
+            .arg("-o")
+            .arg(&out)
+            .timeout(std::time::Duration::from_secs(60))
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains(expected));
+    }
+    // A sparse file just past the cap: refused before a byte is read.
+    let big = dir.path().join("big.json");
+    let file = std::fs::File::create(&big).unwrap();
+    file.set_len(ntori::io::model_file::MAX_MODEL_BYTES + 1)
+        .unwrap();
+    ntori()
+        .arg("render")
+        .arg(&big)
+        .arg("-o")
+        .arg(dir.path().join("x.png"))
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(format!(
+            "a model file may have at most {}",
+            ntori::io::model_file::MAX_MODEL_BYTES
+        )));
+}
+
+#[test]
+fn sizes_beyond_the_memory_caps_are_refused_before_any_work() {
+    // tessellate: genus 2 at t_e = 1000 would take 3.4 GB.
+    ntori()
+        .args(["tessellate", "-g", "2", "--te", "1000"])
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "genus 2 at t_e = 1000, t_r = 4 makes 8112000 triangles, about 4.5 GB",
+        ))
+        .stderr(predicate::str::contains("at most 4000000 triangles"));
+    // new: genus 8 at resolution 1024 ran 15 minutes to 10.9 GB; now refused while meshing.
+    let dir = tempfile::tempdir().unwrap();
+    ntori()
+        .args(["new", "-g", "8", "--resolution", "1024", "-q", "-o"])
+        .arg(dir.path().join("m.json"))
+        .timeout(std::time::Duration::from_secs(120))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("makes more than"))
+        .stderr(predicate::str::contains("lower the resolution"));
+    assert!(!dir.path().join("m.json").exists());
+    // render: genus 64 at T = 64 is 5.2 million triangles (within the buffer cap, over the
+    // triangle cap; a device with less than 750 MB per buffer says so first).
+    let model = constant_model(dir.path(), 64);
+    ntori()
+        .arg("render")
+        .arg(&model)
+        .args(["--tessellation", "64", "-q", "-o"])
+        .arg(dir.path().join("m.png"))
+        .timeout(std::time::Duration::from_secs(120))
+        .assert()
+        .code(1)
+        .stderr(
+            predicate::str::contains("makes 5210112 triangles; a picture may have at most 4000000")
+                .or(predicate::str::contains("max_buffer_size")),
+        );
+}
+
+/// The small fitted torus with every control point multiplied by `scale` (and point 0 moved to
+/// `outlier` where given), written to `dir/name`.
+fn scaled_model(dir: &Path, name: &str, scale: f64, outlier: Option<f64>) -> std::path::PathBuf {
+    let mut model = crate::common::small_model(1).to_model();
+    for p in &mut model.control_points {
+        *p = p.map(|x| x * scale);
+    }
+    if let Some(o) = outlier {
+        model.control_points[0] = [o, o, o];
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_string(&model).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn numbers_that_do_not_survive_f32_are_refused_not_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let huge = scaled_model(dir.path(), "huge.json", 1e39, None);
+    let outlier = scaled_model(dir.path(), "outlier.json", 1.0, Some(1e155));
+    let tiny = scaled_model(dir.path(), "tiny.json", 1e-46, None);
+    let fine = scaled_model(dir.path(), "fine.json", 1.0, None);
+    for ext in ["obj", "ply", "stl", "glb", "off"] {
+        let out = dir.path().join(format!("m.{ext}"));
+        for (model, expected) in [
+            (&huge, "beyond the 32-bit floats"),
+            (&outlier, "beyond the 32-bit floats"),
+            (&tiny, "below what the 32-bit floats"),
+        ] {
+            ntori()
+                .arg("export")
+                .arg(model)
+                .args(["--te", "4", "--tr", "4", "-q", "-o"])
+                .arg(&out)
+                .assert()
+                .code(1)
+                .stderr(predicate::str::contains(expected));
+            assert!(!out.exists(), "{ext}: nothing written");
+        }
+        // The same surface at a sane scale exports.
+        ntori()
+            .arg("export")
+            .arg(&fine)
+            .args(["--te", "4", "--tr", "4", "-q", "-o"])
+            .arg(&out)
+            .assert()
+            .success();
+    }
+    let png = dir.path().join("m.png");
+    let constant = constant_model(dir.path(), 1);
+    for (model, expected) in [
+        (&huge, "beyond the 32-bit floats the GPU"),
+        (&tiny, "below what the GPU's 32-bit floats"),
+        (&constant, "the surface is degenerate"),
+    ] {
+        ntori()
+            .arg("render")
+            .arg(model)
+            .args(["--size", "64x48", "--tessellation", "4", "-q", "-o"])
+            .arg(&png)
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains(expected));
+        assert!(!png.exists());
+    }
+}
+
+#[test]
+fn messages_are_plain_and_said_once() {
+    let dir = tempfile::tempdir().unwrap();
+    // -1 is refused as a genus, not with u32's range.
+    ntori()
+        .args(["info", "--genus", "-1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "a genus is 0 or more (0 to 64), got -1",
+        ))
+        .stderr(predicate::str::contains("4294967295").not());
+    // An absurd smoothness is an argument error, not "the edit's constraints could not be solved".
+    ntori()
+        .args(["new", "-g", "1", "--smoothness", "1e308", "-q", "-o"])
+        .arg(dir.path().join("m.json"))
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(
+            "the smoothness weight must lie in (0, 1e6]",
+        ));
+    // A model whose count is wrong: the cause (from the embedding crate) appears once.
+    let mut model = crate::common::small_model(1).to_model();
+    model.control_points.pop();
+    let path = dir.path().join("short.json");
+    std::fs::write(&path, serde_json::to_string(&model).unwrap()).unwrap();
+    let out = ntori()
+        .arg("export")
+        .arg(&path)
+        .arg("-o")
+        .arg(dir.path().join("m.obj"))
+        .assert()
+        .code(1)
+        .get_output()
+        .stderr
+        .clone();
+    let text = String::from_utf8(out).unwrap();
+    assert_eq!(
+        text.matches("control points, its settings need").count(),
+        1,
+        "{text}"
+    );
+    // Log lines to a pipe carry no colour codes.
+    let out = ntori()
+        .args([
+            "-v",
+            "tessellate",
+            "-g",
+            "2",
+            "--te",
+            "1",
+            "--tr",
+            "1",
+            "--svg",
+        ])
+        .arg(dir.path().join("t.svg"))
+        .assert()
+        .success()
+        .get_output()
+        .stderr
+        .clone();
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.contains("wrote the drawing"), "{text}");
+    assert!(!text.contains('\u{1b}'), "escape codes in {text:?}");
+}
+
+#[test]
+fn render_without_a_runtime_directory_prints_nothing_when_quiet() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = scaled_model(dir.path(), "m.json", 1.0, None);
+    ntori()
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .arg("render")
+        .arg(&model)
+        .args(["--size", "64x48", "--tessellation", "4", "-q", "-o"])
+        .arg(dir.path().join("m.png"))
+        .assert()
+        .success()
+        .stdout("")
+        .stderr("");
+}
