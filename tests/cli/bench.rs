@@ -1,19 +1,10 @@
 //! `ntori bench` prints well-formed JSON with positive, finite figures.
 
-use crate::common::ntori;
+use crate::common::{ntori, ntori_json};
 
 #[test]
 fn bench_prints_json_figures() {
-    let out = ntori()
-        .args(["bench", "--quiet", "--vertices", "3000", "--genus", "3"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = ntori_json(&["bench", "--quiet", "--vertices", "3000", "--genus", "3"]);
     assert!(v["copy_bandwidth_bytes_per_second"].as_f64().unwrap() > 1e8);
     let figures = v["figures"].as_array().unwrap();
     let names: Vec<&str> = figures

@@ -2,7 +2,7 @@
 
 use predicates::prelude::*;
 
-use crate::common::ntori;
+use crate::common::{ntori, ntori_json};
 
 #[test]
 fn default_info_describes_genus_two_and_passes_its_self_check() {
@@ -20,16 +20,7 @@ fn default_info_describes_genus_two_and_passes_its_self_check() {
 #[test]
 fn json_reports_every_supported_kind_of_genus() {
     for genus in ["0", "1", "2", "7"] {
-        let out = ntori()
-            .args(["info", "--json", "--points", "3000", "--genus", genus])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "genus {genus}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+        let v = ntori_json(&["info", "--json", "--points", "3000", "--genus", genus]);
         let n: u64 = genus.parse().unwrap();
         assert_eq!(v["genus"], n);
         assert_eq!(

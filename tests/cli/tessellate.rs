@@ -2,30 +2,21 @@
 
 use predicates::prelude::*;
 
-use crate::common::ntori;
+use crate::common::{ntori, ntori_json};
 
 #[test]
 fn reports_counts_and_checks_as_json() {
     for (genus, te, tr) in [(0, 2, 2), (1, 3, 1), (2, 1, 1), (3, 4, 2)] {
-        let out = ntori()
-            .args([
-                "tessellate",
-                "--json",
-                "--genus",
-                &genus.to_string(),
-                "--te",
-                &te.to_string(),
-                "--tr",
-                &tr.to_string(),
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let v = ntori_json(&[
+            "tessellate",
+            "--json",
+            "--genus",
+            &genus.to_string(),
+            "--te",
+            &te.to_string(),
+            "--tr",
+            &tr.to_string(),
+        ]);
         assert_eq!(v["euler_characteristic"], 2 - 2 * genus);
         assert_eq!(v["topology"]["genus"], genus);
         assert_eq!(v["topology"]["components"], 1);

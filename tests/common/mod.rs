@@ -12,6 +12,21 @@ pub fn ntori() -> assert_cmd::Command {
     assert_cmd::Command::cargo_bin("ntori").expect("the ntori binary is built")
 }
 
+/// Runs `ntori ARGS`, which must succeed (else the test fails with its stderr), and parses what it
+/// printed as JSON.
+pub fn ntori_json<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> serde_json::Value {
+    let out = ntori().args(args).output().expect("ntori runs");
+    assert!(
+        out.status.success(),
+        "ntori {:?}: {}",
+        args.iter()
+            .map(|a| a.as_ref().to_owned())
+            .collect::<Vec<_>>(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("ntori prints valid JSON")
+}
+
 /// Where the example models live (see assets/README.md).
 pub fn asset(name: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
