@@ -22,8 +22,14 @@ use super::{GenusArg, spinner};
 ///
 /// Prints the fit's checks: folded triangles in the parameterization (0: a bijection), the
 /// residual |S(p_i) − P_i| at the mesh vertices as a fraction of the mesh's size, and Gauss–Bonnet
-/// (∫K dA from the analytic curvature against 2π(2 − 2n)). Exit status 3 if a check fails. An
-/// existing file is not replaced unless --force is given.
+/// (∫K dA from the analytic curvature against 2π(2 − 2n)). If a check fails, no model is written
+/// (unless --keep-failed) and the exit status is 3. An existing file is not replaced unless --force
+/// is given.
+///
+/// Also prints measures of shape, which topology cannot see: how far apart overlapping patches are
+/// where both show (a ripple's cause), as a fraction of the diagonal; the largest principal
+/// curvature |κ| (a crease or spike stands out); and the angle between the surface's normal and the
+/// input mesh's at the mesh vertices (median and 90th percentile).
 ///
 /// Examples:
 ///   ntori new                                 genus 2, written to model.json
@@ -39,6 +45,9 @@ pub struct Args {
     /// Replace the output file if it exists.
     #[arg(long)]
     force: bool,
+    /// Write the model even if a check fails (the exit status is still 3).
+    #[arg(long)]
+    keep_failed: bool,
     /// Input mesh resolution: points around each hole (around the equator for the sphere).
     #[arg(long, default_value_t = 32, value_name = "R",
           value_parser = clap::value_parser!(u64).range(8..=1024))]
@@ -72,6 +81,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         genus: GenusArg { genus },
         output,
         force,
+        keep_failed,
         resolution,
         grid,
         degree,
@@ -102,9 +112,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     });
     bar.finish_and_clear();
     let (model, report) = made.with_context(|| format!("cannot make a genus-{genus} model"))?;
-    if force {
+    // A model that fails its checks is not what was asked for: unless the user wants it anyway,
+    // nothing replaces the output or takes its place.
+    let written = report.passed || keep_failed;
+    if written && force {
         ntori::io::model_file::save(&output, &model)?;
-    } else {
+    } else if written {
         // Exclusive: a file created at the output during the fit is kept, not replaced.
         ntori::io::model_file::save_new(&output, &model)?;
     }
@@ -112,6 +125,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &Written {
             report: &report,
             output: &output,
+            written,
         },
         json,
     )
@@ -144,6 +158,8 @@ struct Written<'a> {
     report: &'a NewReport,
     #[serde(skip)]
     output: &'a Path,
+    #[serde(skip)]
+    written: bool,
 }
 
 impl Report for Written<'_> {
@@ -152,7 +168,15 @@ impl Report for Written<'_> {
     }
 
     fn to_text(&self) -> String {
-        self.report.to_text() + &format!("wrote {}\n", self.output.display())
+        let outcome = if self.written {
+            format!("wrote {}\n", self.output.display())
+        } else {
+            format!(
+                "not written to {}: a check failed (--keep-failed writes it anyway)\n",
+                self.output.display()
+            )
+        };
+        self.report.to_text() + &outcome
     }
 }
 
@@ -178,8 +202,47 @@ pub struct NewReport {
     /// |∫K dA − 2π(2 − 2n)| / max(|2π(2 − 2n)|, ∫|K| dA).
     pub curvature_error: f64,
     pub area: f64,
+    /// Measures of shape (see `embedding::quality`), reported, not yet gated on.
+    pub shape: ShapeReport,
     pub seconds: f64,
     pub passed: bool,
+}
+
+/// What topology cannot see: patch disagreement, curvature extremes, normal deviation.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ShapeReport {
+    /// The largest and the rms distance between overlapping patches that both carry blend weight
+    /// ≥ 0.1, as fractions of the diagonal, over the vertices of the t_e = t_r = 16 tessellation.
+    pub patch_disagreement: f64,
+    pub patch_disagreement_rms: f64,
+    /// The largest |κ| of a principal curvature over the same points (model units⁻¹).
+    pub max_principal_curvature: f64,
+    /// The angle between the surface's normal and the input mesh's at its vertices, in degrees.
+    pub normal_deviation_median: f64,
+    pub normal_deviation_p90: f64,
+}
+
+/// The tessellation the shape measures sample (t_e = t_r).
+const SHAPE_SAMPLES: u32 = 16;
+
+fn measure_shape(
+    surface: &Surface,
+    fit: &embedding::fit::Parameterization,
+    mesh: &embedding::holed::HoledMesh,
+    diagonal: f64,
+) -> Result<ShapeReport, embedding::EmbeddingError> {
+    use embedding::quality;
+    let points = quality::sample_points(surface, SHAPE_SAMPLES)?;
+    let disagreement = quality::patch_disagreement(surface, &points, 0.1);
+    let curvature = quality::max_principal_curvature(surface, &points);
+    let normals = quality::normal_deviation(surface, &fit.points, &mesh.positions, &mesh.triangles);
+    Ok(ShapeReport {
+        patch_disagreement: disagreement.max / diagonal,
+        patch_disagreement_rms: disagreement.rms / diagonal,
+        max_principal_curvature: curvature.max_abs,
+        normal_deviation_median: normals.median,
+        normal_deviation_p90: normals.p90,
+    })
 }
 
 /// Largest relative Gauss–Bonnet error the check accepts (relative to ∫|K| dA for the torus).
@@ -210,6 +273,8 @@ pub fn make(
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
     let curvature_error =
         (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
+    stage("measuring the shape");
+    let shape = measure_shape(&surface, &parameterization, &mesh, mesh_diagonal)?;
     let report = NewReport {
         genus,
         settings,
@@ -226,6 +291,7 @@ pub fn make(
         expected_curvature: expected,
         curvature_error,
         area: sums.area,
+        shape,
         seconds: start.elapsed().as_secs_f64(),
         passed: parameterization.folded == 0
             && curvature_error <= CURVATURE_TOLERANCE
@@ -245,6 +311,8 @@ impl NewReport {
              parameterization: {sweeps} relaxation sweeps, {folded} folded triangles ({bij})\n\
              fit residual: rms {rms:.3}%, max {max:.3}% of the diagonal ({res})\n\
              Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, relative error {gb:.1e} ({gbv})\n\
+             shape: patches disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%), \
+             largest |κ| {kmax:.2}, normals {nmed:.2}° from the input mesh's (90%: {n90:.2}°)\n\
              area {area:.4}, {secs:.2} s\n",
             genus = self.genus,
             degree = self.settings.degree,
@@ -264,6 +332,11 @@ impl NewReport {
             e = self.expected_curvature,
             gb = self.curvature_error,
             gbv = verdict(self.curvature_error <= CURVATURE_TOLERANCE),
+            pd = 100.0 * self.shape.patch_disagreement,
+            pdr = 100.0 * self.shape.patch_disagreement_rms,
+            kmax = self.shape.max_principal_curvature,
+            nmed = self.shape.normal_deviation_median,
+            n90 = self.shape.normal_deviation_p90,
             area = self.area,
             secs = self.seconds,
         )

@@ -57,3 +57,88 @@ fn new_rejects_impossible_parameters() {
         assert!(!path.exists(), "{args:?} left a file");
     }
 }
+
+#[test]
+fn a_model_that_fails_its_checks_is_written_only_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("flat.json");
+    // So much smoothing that the fit misses the mesh: the residual check fails.
+    let failing = ["new", "--genus", "0", "--resolution", "8", "--grid", "4"];
+    let out = ntori()
+        .args(failing)
+        .args(["--smoothness", "1e6", "--json", "-o"])
+        .arg(&path)
+        .assert()
+        .code(3)
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(report["passed"], false);
+    assert!(report["max_residual"].as_f64().unwrap() > 0.01);
+    assert!(!path.exists(), "a failed model was written");
+    ntori()
+        .args(failing)
+        .args(["--smoothness", "1e6", "-o"])
+        .arg(&path)
+        .assert()
+        .code(3)
+        .stdout(
+            predicate::str::contains("not written").and(predicate::str::contains("--keep-failed")),
+        );
+    assert!(!path.exists());
+    // Asked for explicitly: written, and still exit status 3.
+    ntori()
+        .args(failing)
+        .args(["--smoothness", "1e6", "--keep-failed", "-o"])
+        .arg(&path)
+        .assert()
+        .code(3)
+        .stdout(predicate::str::contains("wrote"));
+    assert!(path.exists());
+}
+
+#[test]
+fn the_report_measures_the_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sphere.json");
+    let out = ntori()
+        .args([
+            "new",
+            "--genus",
+            "0",
+            "--resolution",
+            "16",
+            "--grid",
+            "8",
+            "--json",
+            "-o",
+        ])
+        .arg(&path)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let shape = &serde_json::from_slice::<serde_json::Value>(&out).unwrap()["shape"];
+    let number = |k: &str| shape[k].as_f64().unwrap_or_else(|| panic!("{k}: {shape}"));
+    // The input is the unit sphere (bounding-box diagonal 2√3): a closed surface inside a ball of
+    // radius R has |κ| ≥ 1/R somewhere, and the grid-8 fit is near round.
+    assert!(
+        (1.0..3.0).contains(&number("max_principal_curvature")),
+        "{shape}"
+    );
+    assert!(number("normal_deviation_median") <= number("normal_deviation_p90"));
+    assert!(number("normal_deviation_p90") < 10.0, "{shape}");
+    // The disagreement is the library's, measured on the model as written (16×16 tessellation).
+    assert!(number("patch_disagreement_rms") <= number("patch_disagreement"));
+    let surface = ntori::io::model_file::load(&path).unwrap();
+    let points = embedding::quality::sample_points(&surface, 16).unwrap();
+    let direct = embedding::quality::patch_disagreement(&surface, &points, 0.1);
+    let diagonal = 2.0 * 3f64.sqrt();
+    assert!(
+        (number("patch_disagreement") - direct.max / diagonal).abs() < 1e-3,
+        "{shape} vs {}",
+        direct.max / diagonal
+    );
+}
