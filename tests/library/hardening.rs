@@ -158,6 +158,37 @@ fn file_errors_name_the_target_not_a_temporary_file() {
     } // else: running as root, which may write anywhere.
 }
 
+#[test]
+fn a_directory_that_takes_no_files_is_named_without_the_temporary_file() {
+    // /proc takes no new files, not even from root: tempfile's error names its temporary file,
+    // which the message must not show.
+    let target = std::path::Path::new("/proc/ntori-hardening.txt");
+    if !std::path::Path::new("/proc/self").exists() {
+        return; // not Linux
+    }
+    let err = ntori::io::atomic::write_atomically(target, b"x").expect_err("/proc takes no files");
+    let text = err.to_string();
+    assert!(!text.contains(".ntori-"), "{text}");
+    assert!(!text.contains(".tmp"), "{text}");
+    assert_eq!(text.matches("ntori-hardening.txt").count(), 1, "{text}");
+}
+
+#[test]
+fn saved_models_hold_only_finite_numbers() {
+    let surface = small_model(1);
+    let mut points = surface.control_points().to_vec();
+    points[3].y = f64::NAN;
+    assert!(surface.with_control_points(points.clone()).is_err());
+    points[3].y = f64::INFINITY;
+    assert!(surface.with_control_points(points).is_err());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.json");
+    ntori::io::model_file::save(&path, surface).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(!text.contains("null") && !text.contains("NaN"), "{text}");
+    assert_eq!(&ntori::io::model_file::load(&path).unwrap(), surface);
+}
+
 fn write_atomically_failing(path: &std::path::Path) -> ntori::io::atomic::FileError {
     ntori::io::atomic::write_atomically_with(path, |_| {
         Err(std::io::Error::other("the writer failed"))
