@@ -126,7 +126,8 @@ pub struct InitialFit {
 /// factorizations dominate. Rounded up.
 pub const FIT_BYTES_PER_TRIANGLE: u64 = 21_000;
 /// The most input triangles [`initial_model`] fits: about 4.2 GB at the rate above. Genus 16 at
-/// resolution 32 (155 820 triangles) fits; genus 64 makes 1.8 million even at resolution 8.
+/// resolution 32 (155 820 triangles) is within the cap; genus 64 makes 1.8 million even at
+/// resolution 8, so no genus-64 fit is possible on this path.
 pub const MAX_FIT_TRIANGLES: usize = 200_000;
 
 /// The whole pipeline: mesh (at `resolution`), cut, flatten, fit. Refuses, before the fit
