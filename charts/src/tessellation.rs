@@ -63,24 +63,27 @@ pub const EDGE_INSIDE_ARC: u32 = 1;
 pub const EDGE_VERTEX_ARC: u32 = 2;
 
 impl Tessellation {
-    /// The vertex count the module's formula predicts.
+    /// The vertex count the module's formula predicts (t_e, t_r ≥ 1), saturating at `u64::MAX`:
+    /// callers compare it with their limits before any work, whatever numbers a user typed.
     pub fn expected_vertices(genus: u32, te: u32, tr: u32) -> u64 {
-        let (n, e, r) = (u64::from(genus), u64::from(te), u64::from(tr));
-        if genus == 0 {
-            4 * e + 2 + 8 * e * (r - 1)
+        let (n, e, r) = (u128::from(genus), u128::from(te), u128::from(tr));
+        let count = if genus == 0 {
+            4 * e + 2 + 8 * e * r.saturating_sub(1)
         } else {
-            2 * n * (e * e + 2 * e - 1) + 2 + 8 * n * e * (r - 1)
-        }
+            2 * n * (e * e + 2 * e).saturating_sub(1) + 2 + 8 * n * e * r.saturating_sub(1)
+        };
+        u64::try_from(count).unwrap_or(u64::MAX)
     }
 
-    /// The triangle count the module's formula predicts.
+    /// The triangle count the module's formula predicts (t_e, t_r ≥ 1), saturating at `u64::MAX`.
     pub fn expected_triangles(genus: u32, te: u32, tr: u32) -> u64 {
-        let (n, e, r) = (u64::from(genus), u64::from(te), u64::from(tr));
-        if genus == 0 {
-            8 * e * (2 * r - 1)
+        let (n, e, r) = (u128::from(genus), u128::from(te), u128::from(tr));
+        let count = if genus == 0 {
+            8 * e * (2 * r).saturating_sub(1)
         } else {
-            4 * n * e * e + 8 * n * e * (2 * r - 1)
-        }
+            4 * n * e * e + 8 * n * e * (2 * r).saturating_sub(1)
+        };
+        u64::try_from(count).unwrap_or(u64::MAX)
     }
 }
 

@@ -127,7 +127,8 @@ pub struct InitialFit {
 /// factorizations dominate. Rounded up.
 pub const FIT_BYTES_PER_TRIANGLE: u64 = 21_000;
 /// The most input triangles [`initial_model`] fits: about 4.2 GB at the rate above. Genus 16 at
-/// resolution 32 (155 820 triangles) fits; genus 64 makes 1.8 million even at resolution 8.
+/// resolution 32 (155 820 triangles) is within the cap; genus 64 makes 1.8 million even at
+/// resolution 8, so no genus-64 fit is possible on this path.
 pub const MAX_FIT_TRIANGLES: usize = 200_000;
 
 /// The whole pipeline: mesh (at `resolution`), cut, flatten, fit. Refuses, before the fit
@@ -850,8 +851,6 @@ pub fn fit(
         }
     }
     let (rows, cols) = (data_rows + reg_rows, layout.control_count());
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, &triplets)
-        .map_err(|e| EmbeddingError::Parameterization(format!("{e:?}")))?;
     let mut rhs = Mat::<f64>::zeros(rows, 3);
     for (r, t) in targets.iter().enumerate() {
         let scale = (weights[r] / mean_weight).sqrt();
@@ -864,10 +863,26 @@ pub fn fit(
             rhs[(points.len() + k, d)] = scale * t[d];
         }
     }
-    let qr = a
-        .sp_qr()
-        .map_err(|e| EmbeddingError::Parameterization(format!("the fit's QR failed: {e:?}")))?;
-    let x = qr.solve_lstsq(&rhs);
+    let x = match least_squares(rows, cols, &triplets, &rhs)? {
+        Some(x) => x,
+        None => {
+            // faer's supernodal QR panics on some wide systems (measured: genus 1 or 2 with a
+            // 48- or 64-point grid on a resolution-8 or -16 mesh). A row ε·e_c per column makes
+            // the system structurally full rank and the factorization goes through; ε = 1e-6
+            // against data rows of mean weight 1 moves the solution by about ε² of its size.
+            // Only systems that failed take this path, so every other fit is unchanged.
+            const EPSILON: f64 = 1e-6;
+            triplets.extend((0..cols).map(|c| Triplet::new(rows + c, c, EPSILON)));
+            let mut padded = Mat::<f64>::zeros(rows + cols, 3);
+            padded.as_mut().subrows_mut(0, rows).copy_from(&rhs);
+            least_squares(rows + cols, cols, &triplets, &padded)?.ok_or_else(|| {
+                EmbeddingError::Parameterization(format!(
+                    "the sparse least-squares solver failed on {rows} rows and {cols} control \
+                     points; lower the grid or raise the mesh resolution"
+                ))
+            })?
+        }
+    };
     let control: Vec<Point3> = (0..cols)
         .map(|c| Point3::new(x[(c, 0)], x[(c, 1)], x[(c, 2)]))
         .collect();
@@ -880,6 +895,52 @@ pub fn fit(
         )));
     }
     Ok(control)
+}
+
+/// The least-squares solution of A x = rhs (A given by triplets) through faer's sparse QR, or `None`
+/// where faer panicked (an assertion inside its supernodal factorization; see [`fit`]).
+fn least_squares(
+    rows: usize,
+    cols: usize,
+    triplets: &[Triplet<usize, usize, f64>],
+    rhs: &Mat<f64>,
+) -> Result<Option<Mat<f64>>, EmbeddingError> {
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, triplets)
+        .map_err(|e| EmbeddingError::Parameterization(format!("{e:?}")))?;
+    // The closure owns nothing that outlives a panic: `a` is dropped with it, `rhs` only read.
+    let solved = caught_quietly(|| a.sp_qr().map(|qr| qr.solve_lstsq(rhs)));
+    match solved {
+        Ok(Ok(x)) => Ok(Some(x)),
+        Ok(Err(e)) => Err(EmbeddingError::Parameterization(format!(
+            "the fit's QR failed: {e:?}"
+        ))),
+        Err(_) => Ok(None),
+    }
+}
+
+thread_local! {
+    /// Set while [`caught_quietly`] runs its closure on this thread.
+    static CATCHING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f`, turning a panic into `Err` without the panic hook's message on stderr: the caller
+/// handles the failure (here: retries, then a typed error), so "thread 'main' panicked" would only
+/// alarm. The hook is wrapped once; panics on other threads, or outside `f`, reach the hook that
+/// was installed before.
+fn caught_quietly<R>(f: impl FnOnce() -> R) -> std::thread::Result<R> {
+    static WRAP: std::sync::Once = std::sync::Once::new();
+    WRAP.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !CATCHING.with(std::cell::Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    CATCHING.with(|c| c.set(true));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    CATCHING.with(|c| c.set(false));
+    result
 }
 
 /// Second differences of every chart's control grid: along u, along v, and the mixed difference

@@ -260,8 +260,14 @@ fn check_size(genus: u32, te: u32, tr: u32) -> anyhow::Result<()> {
     let triangles = Tessellation::expected_triangles(genus, te, tr);
     if triangles > MAX_TRIANGLES {
         let gb = |t: u64| t as f64 * BYTES_PER_TRIANGLE as f64 / 1e9;
+        // The count saturates at u64::MAX (t_e near 2³²): say "more than" rather than a wrong number.
+        let count = if triangles == u64::MAX {
+            format!("more than {triangles}")
+        } else {
+            triangles.to_string()
+        };
         anyhow::bail!(
-            "genus {genus} at t_e = {te}, t_r = {tr} makes {triangles} triangles, about {:.1} GB of \
+            "genus {genus} at t_e = {te}, t_r = {tr} makes {count} triangles, about {:.1} GB of \
              memory; at most {MAX_TRIANGLES} triangles (about {:.1} GB) are allowed: lower --te or --tr",
             gb(triangles),
             gb(MAX_TRIANGLES)

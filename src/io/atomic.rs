@@ -266,13 +266,19 @@ fn temp_prefix() -> String {
     format!(".ntori-{}-", std::process::id())
 }
 
-/// An I/O error without the path tempfile adds to its messages (a temporary file's name means
-/// nothing to the user; the error names the target instead).
+/// An I/O error without the path tempfile adds to its messages ("… at path \"/dir/.ntori-….tmp\""):
+/// a temporary file's name means nothing to the user, and the error names the target instead.
 fn plain(e: std::io::Error) -> std::io::Error {
-    match e.raw_os_error() {
-        Some(code) => std::io::Error::from_raw_os_error(code),
-        None => std::io::Error::new(e.kind(), e.kind().to_string()),
+    if let Some(code) = e.raw_os_error() {
+        return std::io::Error::from_raw_os_error(code);
     }
+    if let Some(inner) = e.get_ref() {
+        let text = inner.to_string();
+        if let Some(cut) = text.find(" at path ") {
+            return std::io::Error::new(e.kind(), text[..cut].to_owned());
+        }
+    }
+    e
 }
 
 /// Removes `.ntori-<pid>-*.tmp` files in `dir` whose process is gone and that are older than
@@ -332,6 +338,27 @@ fn process_alive(pid: u32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plain_drops_tempfiles_path() {
+        // tempfile's PathError: an io::Error whose custom payload prints "{err} at path {path:?}".
+        #[derive(Debug)]
+        struct PathError;
+        impl std::fmt::Display for PathError {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("No space left on device (os error 28) at path \"/d/.ntori-1-x.tmp\"")
+            }
+        }
+        impl std::error::Error for PathError {}
+        let wrapped = std::io::Error::new(std::io::ErrorKind::StorageFull, PathError);
+        let text = plain(wrapped).to_string();
+        assert_eq!(text, "No space left on device (os error 28)");
+        let os = std::io::Error::from_raw_os_error(28);
+        assert_eq!(
+            plain(os).to_string(),
+            "No space left on device (os error 28)"
+        );
+    }
 
     #[test]
     fn temp_owner_reads_the_pid() {

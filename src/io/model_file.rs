@@ -72,12 +72,25 @@ pub enum ModelFileError {
 pub fn load(path: impl AsRef<Path>) -> Result<Surface, ModelFileError> {
     let path = path.as_ref();
     let bytes = read_capped(path)?;
+    from_bytes(path, &bytes)
+}
+
+/// A model file's contents, checked as [`load`] checks them; `path` only names the file in errors.
+/// (The fuzz tests call this directly.)
+pub fn from_bytes(path: &Path, bytes: &[u8]) -> Result<Surface, ModelFileError> {
+    if bytes.len() as u64 > MAX_MODEL_BYTES {
+        return Err(ModelFileError::TooLarge {
+            path: path.to_owned(),
+            size: bytes.len() as u64,
+            max: MAX_MODEL_BYTES,
+        });
+    }
     let not_a_model = |reason: String| ModelFileError::NotAModel {
         path: path.to_owned(),
         reason,
     };
     // Syntax first (without building anything), so a broken file is "not JSON", not "not a model".
-    serde_json::from_slice::<serde::de::IgnoredAny>(&bytes).map_err(|e| {
+    serde_json::from_slice::<serde::de::IgnoredAny>(bytes).map_err(|e| {
         ModelFileError::NotJson {
             path: path.to_owned(),
             reason: describe(&e, None),
@@ -86,7 +99,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<Surface, ModelFileError> {
     if bytes.iter().find(|b| !b.is_ascii_whitespace()) != Some(&b'{') {
         return Err(not_a_model("the JSON is not an object".into()));
     }
-    let header: ModelHeader = serde_json::from_slice(&bytes).map_err(|e| {
+    let header: ModelHeader = serde_json::from_slice(bytes).map_err(|e| {
         not_a_model(format!(
             "it has no valid \"format\" and \"version\" fields ({})",
             describe(&e, None)
@@ -111,7 +124,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<Surface, ModelFileError> {
             embedding::MODEL_VERSION
         )));
     }
-    let mut de = serde_json::Deserializer::from_slice(&bytes);
+    let mut de = serde_json::Deserializer::from_slice(bytes);
     let model: Model = serde_path_to_error::deserialize(&mut de)
         .map_err(|e| not_a_model(describe(e.inner(), Some(&field_path(e.path())))))?;
     Surface::from_model(&model).map_err(|source| ModelFileError::Inconsistent {

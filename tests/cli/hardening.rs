@@ -548,3 +548,163 @@ fn render_without_a_runtime_directory_prints_nothing_when_quiet() {
         .stdout("")
         .stderr("");
 }
+
+/// The fixtures `docs/bad-inputs.md` names (`$NAME`), made in `dir`.
+fn bad_input_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
+    let model = scaled_model(dir, "model.json", 1.0, None);
+    let good: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let text = serde_json::to_string(&good).unwrap();
+    let variant = |name: &str, contents: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, contents).unwrap();
+        path
+    };
+    let edit = |name: &str, f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = good.clone();
+        f(&mut v);
+        variant(name, serde_json::to_string(&v).unwrap())
+    };
+    let fifo = dir.join("fifo");
+    mkfifo(&fifo);
+    let big = dir.join("big.json");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(ntori::io::model_file::MAX_MODEL_BYTES + 1)
+        .unwrap();
+    let constant64 = constant_model(dir, 64);
+    let constant = constant_model(dir, 1);
+    vec![
+        ("MODEL".into(), model),
+        ("CONSTANT64".into(), constant64),
+        ("CONSTANT".into(), constant),
+        ("HUGE".into(), scaled_model(dir, "huge.json", 1e39, None)),
+        ("TINY".into(), scaled_model(dir, "tiny.json", 1e-46, None)),
+        (
+            "NULL".into(),
+            edit("null.json", &|v| {
+                v["control_points"][17][1] = serde_json::Value::Null
+            }),
+        ),
+        (
+            "UNKNOWN".into(),
+            edit("unknown.json", &|v| v["colour"] = "red".into()),
+        ),
+        (
+            "DUPLICATE".into(),
+            variant("duplicate.json", text.replacen("{\"", "{\"genus\":3,\"", 1)),
+        ),
+        (
+            "VERSION0".into(),
+            edit("version0.json", &|v| v["version"] = 0.into()),
+        ),
+        (
+            "FUTURE".into(),
+            edit("future.json", &|v| v["version"] = 99.into()),
+        ),
+        (
+            "LONG_STRING".into(),
+            edit("long.json", &|v| v["genus"] = "y".repeat(1_000_000).into()),
+        ),
+        (
+            "SHORT".into(),
+            edit("short.json", &|v| {
+                v["control_points"].as_array_mut().unwrap().pop();
+            }),
+        ),
+        (
+            "TRUNCATED".into(),
+            variant("truncated.json", text[..100].to_owned()),
+        ),
+        ("BIG".into(), big),
+        ("FIFO".into(), fifo),
+        ("OUT".into(), dir.join("out")),
+        ("DIR".into(), dir.to_path_buf()),
+    ]
+}
+
+/// One row of a table in docs/bad-inputs.md: the command's words, the exit status, the message.
+struct Row {
+    line: usize,
+    command: String,
+    exit: i32,
+    message: String,
+}
+
+fn bad_input_rows() -> Vec<Row> {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/bad-inputs.md"))
+            .unwrap();
+    let mut rows = Vec::new();
+    for (k, line) in doc.lines().enumerate() {
+        let cells: Vec<&str> = line.split(" | ").map(str::trim).collect();
+        let [_, command, exit, message] = cells[..] else {
+            continue;
+        };
+        let Some(command) = command.strip_prefix('`').and_then(|c| c.strip_suffix('`')) else {
+            continue;
+        };
+        rows.push(Row {
+            line: k + 1,
+            command: command.to_owned(),
+            exit: exit
+                .parse()
+                .unwrap_or_else(|_| panic!("line {}: exit {exit:?}", k + 1)),
+            message: message
+                .trim_end_matches(" |")
+                .trim_end_matches('|')
+                .trim()
+                .to_owned(),
+        });
+    }
+    rows
+}
+
+#[test]
+fn bad_inputs_table_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    let fixtures = bad_input_fixtures(dir.path());
+    let rows = bad_input_rows();
+    assert!(rows.len() >= 37, "the table has {} rows", rows.len());
+    for row in rows {
+        let args: Vec<String> = row
+            .command
+            .split_whitespace()
+            .map(|word| {
+                let mut word = word.to_owned();
+                for (name, path) in &fixtures {
+                    let token = format!("${name}");
+                    if word.starts_with(&token) {
+                        word = word.replacen(&token, &path.display().to_string(), 1);
+                        break;
+                    }
+                }
+                word
+            })
+            .collect();
+        let out = ntori()
+            .args(&args)
+            .timeout(std::time::Duration::from_secs(300))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            out.status.code(),
+            Some(row.exit),
+            "docs/bad-inputs.md line {}: `{}`: {stderr}",
+            row.line,
+            row.command
+        );
+        assert!(
+            stderr.contains(&row.message),
+            "docs/bad-inputs.md line {}: `{}`: expected {:?} in {stderr}",
+            row.line,
+            row.command,
+            row.message
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+    // Nothing was written where a row refused.
+    assert!(!dir.path().join("out.obj").exists() && !dir.path().join("out.png").exists());
+    assert!(is_fifo(&dir.path().join("fifo")));
+}

@@ -158,6 +158,37 @@ fn file_errors_name_the_target_not_a_temporary_file() {
     } // else: running as root, which may write anywhere.
 }
 
+#[test]
+fn a_directory_that_takes_no_files_is_named_without_the_temporary_file() {
+    // /proc takes no new files, not even from root: tempfile's error names its temporary file,
+    // which the message must not show.
+    let target = std::path::Path::new("/proc/ntori-hardening.txt");
+    if !std::path::Path::new("/proc/self").exists() {
+        return; // not Linux
+    }
+    let err = ntori::io::atomic::write_atomically(target, b"x").expect_err("/proc takes no files");
+    let text = err.to_string();
+    assert!(!text.contains(".ntori-"), "{text}");
+    assert!(!text.contains(".tmp"), "{text}");
+    assert_eq!(text.matches("ntori-hardening.txt").count(), 1, "{text}");
+}
+
+#[test]
+fn saved_models_hold_only_finite_numbers() {
+    let surface = small_model(1);
+    let mut points = surface.control_points().to_vec();
+    points[3].y = f64::NAN;
+    assert!(surface.with_control_points(points.clone()).is_err());
+    points[3].y = f64::INFINITY;
+    assert!(surface.with_control_points(points).is_err());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.json");
+    ntori::io::model_file::save(&path, surface).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(!text.contains("null") && !text.contains("NaN"), "{text}");
+    assert_eq!(&ntori::io::model_file::load(&path).unwrap(), surface);
+}
+
 fn write_atomically_failing(path: &std::path::Path) -> ntori::io::atomic::FileError {
     ntori::io::atomic::write_atomically_with(path, |_| {
         Err(std::io::Error::other("the writer failed"))
@@ -192,4 +223,223 @@ fn fits_beyond_the_memory_cap_are_refused_before_fitting() {
     // The largest genus-16 mesh at resolution 32 is within the cap: it is meshed, not refused.
     let mesh = embedding::holed::HoledMesh::new(16, 32).unwrap();
     assert!(mesh.triangles.len() <= MAX_FIT_TRIANGLES);
+}
+
+// ----------------------------------------------------------------------------------- fuzzing
+
+/// Interesting replacements for a number in a model file.
+const TOKENS: &[&str] = &[
+    "1e309",
+    "-1e309",
+    "NaN",
+    "null",
+    "1e-400",
+    "4294967296",
+    "-1",
+    "0",
+    "-0",
+    "3.5e38",
+    "1e155",
+    "1e-46",
+    "\"x\"",
+    "[]",
+    "{}",
+    "true",
+    "99999999999999999999999",
+    "4096",
+    "7",
+    "64",
+    "65",
+    "1.5",
+];
+
+/// One edit of a model file's bytes.
+#[derive(Clone, Debug)]
+enum Mutation {
+    FlipBit(proptest::sample::Index, u8),
+    SetByte(proptest::sample::Index, u8),
+    Insert(proptest::sample::Index, Vec<u8>),
+    Delete(proptest::sample::Index, usize),
+    Truncate(proptest::sample::Index),
+    /// The nth number replaced by a token of [`TOKENS`].
+    Number(proptest::sample::Index, proptest::sample::Index),
+    /// A span copied elsewhere (duplicate keys, repeated points, nested arrays).
+    Splice(proptest::sample::Index, usize, proptest::sample::Index),
+}
+
+fn mutation() -> impl proptest::strategy::Strategy<Value = Mutation> {
+    use proptest::prelude::*;
+    prop_oneof![
+        1 => (any::<proptest::sample::Index>(), 0u8..8).prop_map(|(i, b)| Mutation::FlipBit(i, b)),
+        1 => (any::<proptest::sample::Index>(), any::<u8>()).prop_map(|(i, b)| Mutation::SetByte(i, b)),
+        1 => (
+            any::<proptest::sample::Index>(),
+            proptest::collection::vec(
+                prop_oneof![
+                    Just(b'['),
+                    Just(b']'),
+                    Just(b'{'),
+                    Just(b'}'),
+                    Just(b','),
+                    Just(b':'),
+                    Just(b'"'),
+                    Just(b'\\'),
+                    any::<u8>()
+                ],
+                1..8
+            )
+        )
+            .prop_map(|(i, b)| Mutation::Insert(i, b)),
+        1 => (any::<proptest::sample::Index>(), 1usize..64).prop_map(|(i, n)| Mutation::Delete(i, n)),
+        1 => any::<proptest::sample::Index>().prop_map(Mutation::Truncate),
+        // Weighted up: replacing numbers keeps the JSON valid and reaches the model's checks.
+        4 => (
+            any::<proptest::sample::Index>(),
+            any::<proptest::sample::Index>()
+        )
+            .prop_map(|(i, t)| Mutation::Number(i, t)),
+        2 => (
+            any::<proptest::sample::Index>(),
+            1usize..200,
+            any::<proptest::sample::Index>()
+        )
+            .prop_map(|(f, n, t)| Mutation::Splice(f, n, t)),
+    ]
+}
+
+fn apply(bytes: &mut Vec<u8>, m: &Mutation) {
+    if bytes.is_empty() {
+        return;
+    }
+    let len = bytes.len();
+    match m {
+        Mutation::FlipBit(i, b) => bytes[i.index(len)] ^= 1 << b,
+        Mutation::SetByte(i, b) => bytes[i.index(len)] = *b,
+        Mutation::Insert(i, b) => {
+            let at = i.index(len + 1);
+            bytes.splice(at..at, b.iter().copied());
+        }
+        Mutation::Delete(i, n) => {
+            let at = i.index(len);
+            bytes.drain(at..(at + n).min(len));
+        }
+        Mutation::Truncate(i) => bytes.truncate(i.index(len)),
+        Mutation::Number(i, t) => {
+            // Runs of number characters after a ':' ',' or '['.
+            let mut numbers = Vec::new();
+            let mut k = 0;
+            while k < len {
+                let starts = matches!(bytes[k], b'-' | b'0'..=b'9')
+                    && (k == 0 || matches!(bytes[k - 1], b':' | b',' | b'['));
+                if starts {
+                    let end = (k..len)
+                        .find(|&e| {
+                            !matches!(bytes[e], b'-' | b'+' | b'.' | b'e' | b'E' | b'0'..=b'9')
+                        })
+                        .unwrap_or(len);
+                    numbers.push(k..end);
+                    k = end;
+                } else {
+                    k += 1;
+                }
+            }
+            if !numbers.is_empty() {
+                let range = numbers[i.index(numbers.len())].clone();
+                let token = TOKENS[t.index(TOKENS.len())].as_bytes();
+                bytes.splice(range, token.iter().copied());
+            }
+        }
+        Mutation::Splice(f, n, t) => {
+            let from = f.index(len);
+            let span: Vec<u8> = bytes[from..(from + n).min(len)].to_vec();
+            let to = t.index(len + 1);
+            bytes.splice(to..to, span);
+        }
+    }
+}
+
+/// The seeds: every file of `tests/fuzz-corpus/` (valid models of genus 0, 1 and 2).
+fn corpus() -> Vec<Vec<u8>> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz-corpus");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    files.iter().map(|p| std::fs::read(p).unwrap()).collect()
+}
+
+/// Mutated model files (1 to 4 edits of a corpus file) never make the loader panic; what it
+/// accepts is a valid surface that saves and loads back the same; what it refuses gets one short
+/// message naming the file once. NTORI_FUZZ_CASES sets the number of cases (default 10 000; the
+/// long run used 10⁶).
+#[test]
+fn fuzz_model_loader() {
+    use proptest::strategy::Strategy as _;
+    use std::collections::BTreeMap;
+    let cases: u32 = std::env::var("NTORI_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(10_000);
+    let seeds = corpus();
+    assert!(!seeds.is_empty());
+    // Every seed loads as is.
+    let name = std::path::Path::new("fuzzed.json");
+    for seed in &seeds {
+        ntori::io::model_file::from_bytes(name, seed).expect("a corpus file loads");
+    }
+    let strategy = (
+        proptest::sample::select((0..seeds.len()).collect::<Vec<_>>()),
+        proptest::collection::vec(mutation(), 1..5),
+    );
+    let outcomes = std::cell::RefCell::new(BTreeMap::<String, u64>::new());
+    let mut runner = proptest::test_runner::TestRunner::new(proptest::test_runner::Config {
+        cases,
+        failure_persistence: None,
+        ..Default::default()
+    });
+    let start = std::time::Instant::now();
+    let result = runner.run(&strategy.boxed(), |(seed, mutations)| {
+        let mut bytes = seeds[seed].clone();
+        for m in &mutations {
+            apply(&mut bytes, m);
+        }
+        let loaded = std::panic::catch_unwind(|| ntori::io::model_file::from_bytes(name, &bytes))
+            .map_err(|_| {
+            proptest::test_runner::TestCaseError::fail(format!(
+                "the loader panicked on {:?}",
+                String::from_utf8_lossy(&bytes)
+            ))
+        })?;
+        let outcome = match &loaded {
+            Ok(surface) => {
+                let text = serde_json::to_string(&surface.to_model()).unwrap();
+                let back = ntori::io::model_file::from_bytes(name, text.as_bytes())
+                    .map_err(|e| proptest::test_runner::TestCaseError::fail(e.to_string()))?;
+                proptest::prop_assert_eq!(&back, surface);
+                "accepted".to_owned()
+            }
+            Err(e) => {
+                let text = e.to_string();
+                proptest::prop_assert!(text.len() <= 1_000, "a long message: {}", text);
+                proptest::prop_assert_eq!(text.matches("fuzzed.json").count(), 1, "{}", text);
+                format!("{e:?}")
+                    .split([' ', '(', '{'])
+                    .next()
+                    .unwrap()
+                    .to_owned()
+            }
+        };
+        *outcomes.borrow_mut().entry(outcome).or_default() += 1;
+        Ok(())
+    });
+    let seconds = start.elapsed().as_secs_f64();
+    let outcomes = outcomes.into_inner();
+    let executions: u64 = outcomes.values().sum();
+    eprintln!(
+        "fuzz_model_loader: {executions} executions in {seconds:.1} s ({:.0}/s), findings: {}; outcomes {outcomes:?}",
+        executions as f64 / seconds,
+        if result.is_ok() { 0 } else { 1 }
+    );
+    result.unwrap();
 }
