@@ -4,7 +4,7 @@
 //! A [`Model`] is the serde document a file holds; a `Surface` is what the program works with. The
 //! conversion checks everything a file can get wrong (format, version, genus, settings, the number
 //! of control points, finiteness); after it, [`Surface::layout`] cannot fail, and every consumer —
-//! export, the renderer, the editor — evaluates through [`crate::evaluate`].
+//! export, the renderer, the editor — evaluates through [`evaluate`](crate::evaluate::evaluate).
 
 use std::sync::Arc;
 

@@ -1,5 +1,5 @@
 //! What the user asks for: the keyboard, the menus, the side panel and the dialogs each add a
-//! [`Command`] while a frame's UI is drawn, and [`EditorApp::apply`] carries them out, in order, at
+//! [`Command`] while a frame's UI is drawn, and `EditorApp::apply` carries them out, in order, at
 //! the start of the next frame, before anything is drawn (the keyboard's at the start of its own
 //! frame). The viewport's pointer input alone acts at once: a drag follows the pointer within its
 //! frame. A finished background job and a held close come back as commands too.
