@@ -4,9 +4,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context as _;
+use charts::ChartPoint;
 use embedding::fit::{FitSettings, InitialFit, initial_model};
+use embedding::holed::HoledMesh;
 use embedding::integrals::surface_integrals;
 use embedding::{SplineSettings, Surface};
+use ntori::io::export::{self, Encoding, Format};
 use serde::Serialize;
 
 use super::report::{Report, emit};
@@ -48,6 +51,10 @@ pub struct Args {
     /// Write the model even if a check fails (the exit status is still 3).
     #[arg(long)]
     keep_failed: bool,
+    /// Also write the mesh the fit targets (OBJ, PLY, STL, GLB or OFF, from the extension), with
+    /// each vertex's fitted chart coordinates as UVs, to compare it with the surface.
+    #[arg(long, value_name = "FILE")]
+    input_mesh: Option<PathBuf>,
     /// Input mesh resolution: points around each hole (around the equator for the sphere).
     #[arg(long, default_value_t = 32, value_name = "R",
           value_parser = clap::value_parser!(u64).range(8..=1024))]
@@ -82,6 +89,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         output,
         force,
         keep_failed,
+        input_mesh,
         resolution,
         grid,
         degree,
@@ -96,6 +104,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if !force && std::fs::symlink_metadata(&target).is_ok() {
         return Err(ntori::io::atomic::FileError::Exists { path: output }.into());
     }
+    let input_mesh = match input_mesh {
+        Some(path) => {
+            let format = Format::from_path(&path)?;
+            let target = ntori::io::atomic::check_output(&path, &[&output])?;
+            if !force && std::fs::symlink_metadata(&target).is_ok() {
+                return Err(ntori::io::atomic::FileError::Exists { path }.into());
+            }
+            Some((path, format))
+        }
+        None => None,
+    };
     let settings = SplineSettings {
         degree: degree as usize,
         continuity: continuity as usize,
@@ -111,7 +130,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         bar.tick();
     });
     bar.finish_and_clear();
-    let (model, report) = made.with_context(|| format!("cannot make a genus-{genus} model"))?;
+    let Made {
+        surface: model,
+        report,
+        mesh,
+        points,
+    } = made.with_context(|| format!("cannot make a genus-{genus} model"))?;
+    // The input mesh is written whatever the checks say: it is what to compare a failed fit with.
+    if let Some((path, format)) = &input_mesh {
+        let exported = export::input_mesh(genus, &mesh.positions, &mesh.triangles, &points)?;
+        export::write(&exported, path, *format, Encoding::Binary)?;
+        if !quiet && !json {
+            eprintln!("ntori: wrote the input mesh to {}", path.display());
+        }
+    }
     // A model that fails its checks is not what was asked for: unless the user wants it anyway,
     // nothing replaces the output or takes its place.
     let written = report.passed || keep_failed;
@@ -250,6 +282,15 @@ pub const CURVATURE_TOLERANCE: f64 = 1e-3;
 /// Largest residual, as a fraction of the diagonal, the check accepts.
 pub const RESIDUAL_TOLERANCE: f64 = 0.01;
 
+/// What [`make`] produced: the model, its report, and the mesh it was fitted to with the chart
+/// point each mesh vertex was fitted at.
+pub struct Made {
+    pub surface: Surface,
+    pub report: NewReport,
+    pub mesh: HoledMesh,
+    pub points: Vec<ChartPoint>,
+}
+
 /// Fits the model and checks it. `stage` is told what is being done.
 pub fn make(
     genus: u32,
@@ -257,7 +298,7 @@ pub fn make(
     settings: SplineSettings,
     fit: FitSettings,
     stage: &dyn Fn(&str),
-) -> Result<(Surface, NewReport), embedding::EmbeddingError> {
+) -> Result<Made, embedding::EmbeddingError> {
     let start = std::time::Instant::now();
     stage("meshing, flattening and fitting");
     let InitialFit {
@@ -297,7 +338,12 @@ pub fn make(
             && curvature_error <= CURVATURE_TOLERANCE
             && max_residual <= RESIDUAL_TOLERANCE * mesh_diagonal,
     };
-    Ok((surface, report))
+    Ok(Made {
+        surface,
+        report,
+        mesh,
+        points: parameterization.points,
+    })
 }
 
 impl NewReport {

@@ -142,3 +142,58 @@ fn the_report_measures_the_shape() {
         direct.max / diagonal
     );
 }
+
+#[test]
+fn the_input_mesh_is_written_for_comparison() {
+    let dir = tempfile::tempdir().unwrap();
+    let (model, input) = (dir.path().join("torus.json"), dir.path().join("input.obj"));
+    let out = ntori()
+        .args([
+            "new",
+            "--genus",
+            "1",
+            "--resolution",
+            "16",
+            "--grid",
+            "8",
+            "--json",
+            "-o",
+        ])
+        .arg(&model)
+        .arg("--input-mesh")
+        .arg(&input)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let (obj, _) = tobj::load_obj(&input, &tobj::GPU_LOAD_OPTIONS).unwrap();
+    let mesh = &obj[0].mesh;
+    assert_eq!(
+        mesh.positions.len() / 3,
+        report["mesh_vertices"].as_u64().unwrap() as usize
+    );
+    assert_eq!(
+        mesh.indices.len() / 3,
+        report["mesh_triangles"].as_u64().unwrap() as usize
+    );
+    assert_eq!(mesh.texcoords.len(), mesh.positions.len() / 3 * 2);
+    let topology =
+        mesh::HalfEdgeMesh::from_polygons(mesh.positions.len() / 3, mesh.indices.chunks(3))
+            .unwrap()
+            .topology();
+    assert!(topology.closed && topology.manifold && topology.orientable);
+    assert_eq!(topology.euler_characteristic, 0);
+    // An unknown extension is refused before the fit, and nothing is written.
+    let (model2, bad) = (dir.path().join("m2.json"), dir.path().join("input.xyz"));
+    ntori()
+        .args(["new", "--genus", "1", "-o"])
+        .arg(&model2)
+        .arg("--input-mesh")
+        .arg(&bad)
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("input.xyz"));
+    assert!(!model2.exists() && !bad.exists());
+}

@@ -258,6 +258,34 @@ pub fn surface_mesh(surface: &Surface, te: u32, tr: u32) -> Result<SurfaceMesh, 
     Ok(mesh)
 }
 
+/// The mesh a fit targets (`ntori new --input-mesh`), as an exportable mesh: its own positions, the
+/// area-weighted normals of its triangles (outward), and as UVs and chart ids the chart point each
+/// vertex was fitted at. Its t_e and t_r are 0 (it is no tessellation of the surface).
+pub fn input_mesh(
+    genus: u32,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    points: &[charts::ChartPoint],
+) -> Result<SurfaceMesh, ExportError> {
+    let mut mesh = SurfaceMesh {
+        genus,
+        te: 0,
+        tr: 0,
+        positions: positions.to_vec(),
+        normals: vec![Vector3::repeat(f64::NAN); positions.len()],
+        uvs: points
+            .iter()
+            .map(|p| [p.coords.re + 0.5, p.coords.im + 0.5])
+            .collect(),
+        charts: points.iter().map(|p| p.chart.0).collect(),
+        triangles: triangles.to_vec(),
+    };
+    // No analytic normals: every vertex takes its triangles' (what repair does for a pinched one).
+    mesh.repair_normals()?;
+    mesh.orient_outward();
+    Ok(mesh)
+}
+
 impl SurfaceMesh {
     /// Where S_u × S_v vanishes (an edit pinched the surface), the normal of the triangles around
     /// the vertex; an error where those have no area either.
@@ -336,6 +364,15 @@ pub fn signed_volume(positions: &[Point3], triangles: &[[u32; 3]]) -> f64 {
 impl SurfaceMesh {
     /// A one-line description for file headers.
     fn describe(&self) -> String {
+        if self.te == 0 {
+            return format!(
+                "ntori {}: the input mesh of a genus-{} fit, {} vertices, {} triangles",
+                env!("CARGO_PKG_VERSION"),
+                self.genus,
+                self.positions.len(),
+                self.triangles.len()
+            );
+        }
         format!(
             "ntori {}: genus {}, t_e = {}, t_r = {}, {} vertices, {} triangles",
             env!("CARGO_PKG_VERSION"),
