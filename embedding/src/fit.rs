@@ -131,6 +131,37 @@ pub const FIT_BYTES_PER_TRIANGLE: u64 = 21_000;
 /// resolution 8, so no genus-64 fit is possible on this path.
 pub const MAX_FIT_TRIANGLES: usize = 200_000;
 
+/// A stage of [`initial_model_with_progress`], for progress displays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitStage {
+    Meshing,
+    /// Cutting the mesh open and flattening it onto the polygon.
+    Flattening,
+    /// Relaxing the map on the closed surface: round `round` of `rounds` (each up to the sweep cap).
+    Relaxing {
+        round: usize,
+        rounds: usize,
+    },
+    /// The least-squares fit of the control points.
+    Fitting,
+}
+
+impl std::fmt::Display for FitStage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FitStage::Meshing => write!(f, "meshing the input"),
+            FitStage::Flattening => write!(f, "cutting and flattening the mesh"),
+            FitStage::Relaxing { round, rounds } => {
+                write!(
+                    f,
+                    "relaxing the map on the surface (round {round} of {rounds})"
+                )
+            }
+            FitStage::Fitting => write!(f, "fitting the control points"),
+        }
+    }
+}
+
 /// The whole pipeline: mesh (at `resolution`), cut, flatten, fit. Refuses, before the fit
 /// allocates anything, an input mesh of more than [`MAX_FIT_TRIANGLES`] triangles
 /// ([`EmbeddingError::FitTooLarge`]).
@@ -140,6 +171,18 @@ pub fn initial_model(
     settings: SplineSettings,
     fit_settings: FitSettings,
 ) -> Result<InitialFit, EmbeddingError> {
+    initial_model_with_progress(genus, resolution, settings, fit_settings, &|_| {})
+}
+
+/// [`initial_model`], telling `progress` each stage as it begins.
+pub fn initial_model_with_progress(
+    genus: u32,
+    resolution: usize,
+    settings: SplineSettings,
+    fit_settings: FitSettings,
+    progress: &dyn Fn(FitStage),
+) -> Result<InitialFit, EmbeddingError> {
+    progress(FitStage::Meshing);
     let atlas = Arc::new(Atlas::new(genus)?);
     let layout = Layout::new(&atlas, settings)?;
     let mesh = HoledMesh::new(genus, resolution)?;
@@ -152,12 +195,19 @@ pub fn initial_model(
             max: MAX_FIT_TRIANGLES,
         });
     }
-    let parameterization = parameterize(
-        &atlas,
-        &mesh,
-        fit_settings.sweeps,
-        fit_settings.stretch_rounds,
-    )?;
+    progress(FitStage::Flattening);
+    let parameterization = match atlas.polygon() {
+        None => stereographic(&atlas, &mesh),
+        Some(polygon) => flatten(
+            &atlas,
+            polygon,
+            &mesh,
+            fit_settings.sweeps,
+            fit_settings.stretch_rounds,
+            progress,
+        )?,
+    };
+    progress(FitStage::Fitting);
     let weights = vertex_areas(&mesh.positions, &mesh.triangles);
     let control = fit(
         &layout,
@@ -381,7 +431,7 @@ pub fn parameterize(
     }
     match atlas.polygon() {
         None => Ok(stereographic(atlas, mesh)),
-        Some(polygon) => flatten(atlas, polygon, mesh, sweeps, stretch_rounds),
+        Some(polygon) => flatten(atlas, polygon, mesh, sweeps, stretch_rounds, &|_| {}),
     }
 }
 
@@ -419,6 +469,7 @@ fn flatten(
     mesh: &HoledMesh,
     sweeps: usize,
     stretch_rounds: usize,
+    progress: &dyn Fn(FitStage),
 ) -> Result<Parameterization, EmbeddingError> {
     let disk = cut(mesh)?;
     let hyperbolic = polygon.geometry() == Geometry::Hyperbolic;
@@ -444,8 +495,11 @@ fn flatten(
         })
         .collect();
     let mut lifts = Lifts::new(polygon, mesh, &disk, &model, &positions)?;
+    let rounds = stretch_rounds + 1;
+    progress(FitStage::Relaxing { round: 1, rounds });
     let mut used = lifts.relax(hyperbolic, sweeps, RELAX_TOLERANCE);
-    for _ in 0..stretch_rounds {
+    for round in 2..=rounds {
+        progress(FitStage::Relaxing { round, rounds });
         let stretch = lifts.stretch(&disk, &positions, hyperbolic);
         lifts.reweight(&stretch);
         used += lifts.relax(hyperbolic, sweeps, RELAX_TOLERANCE);

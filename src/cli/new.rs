@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use charts::ChartPoint;
-use embedding::fit::{FitSettings, InitialFit, initial_model};
+use embedding::fit::{FitSettings, InitialFit, initial_model_with_progress};
 use embedding::holed::HoledMesh;
 use embedding::integrals::surface_integrals;
 use embedding::{SplineSettings, Surface};
@@ -300,7 +300,6 @@ pub fn make(
     stage: &dyn Fn(&str),
 ) -> Result<Made, embedding::EmbeddingError> {
     let start = std::time::Instant::now();
-    stage("meshing, flattening and fitting");
     let InitialFit {
         surface,
         mesh,
@@ -308,7 +307,7 @@ pub fn make(
         rms_residual,
         max_residual,
         mesh_diagonal,
-    } = initial_model(genus, resolution, settings, fit)?;
+    } = initial_model_with_progress(genus, resolution, settings, fit, &|s| stage(&s.to_string()))?;
     stage("integrating the curvature");
     let sums = surface_integrals(&surface.layout(), surface.control_points(), 8);
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));

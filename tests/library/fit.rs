@@ -235,3 +235,27 @@ fn fitted_surfaces_are_close_immersed_embedded_and_satisfy_gauss_bonnet() {
         );
     }
 }
+
+#[test]
+fn the_fit_reports_its_stages_in_order() {
+    use embedding::fit::{FitStage, initial_model_with_progress};
+    let settings = SplineSettings {
+        grid: 6,
+        ..SplineSettings::default()
+    };
+    for genus in [0, 2] {
+        let seen = std::cell::RefCell::new(Vec::new());
+        let fit_settings = FitSettings::default();
+        initial_model_with_progress(genus, 12, settings, fit_settings, &|s| {
+            seen.borrow_mut().push(s)
+        })
+        .unwrap();
+        let mut expected = vec![FitStage::Meshing, FitStage::Flattening];
+        if genus > 0 {
+            let rounds = fit_settings.stretch_rounds + 1;
+            expected.extend((1..=rounds).map(|round| FitStage::Relaxing { round, rounds }));
+        }
+        expected.push(FitStage::Fitting);
+        assert_eq!(seen.into_inner(), expected, "genus {genus}");
+    }
+}
