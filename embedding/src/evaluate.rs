@@ -31,6 +31,15 @@ pub struct Curvatures {
     pub mean: f64,
 }
 
+impl Curvatures {
+    /// The principal curvatures κ₁ ≥ κ₂: H ± √(H² − K).
+    pub fn principal(&self) -> (f64, f64) {
+        // H² ≥ K holds exactly; rounding can make the difference a hair negative at umbilics.
+        let root = (self.mean * self.mean - self.gaussian).max(0.0).sqrt();
+        (self.mean + root, self.mean - root)
+    }
+}
+
 /// One evaluated surface point.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sample {

@@ -125,8 +125,8 @@ pub fn max_principal_curvature(surface: &Surface, points: &[ChartPoint]) -> Curv
     evaluate::evaluate(surface, points, wants, 0.0, &mut |s: &evaluate::Sample| {
         let k = match s.curvature {
             Some(c) if s.normal.is_some() => {
-                let root = (c.mean * c.mean - c.gaussian).max(0.0).sqrt();
-                c.mean.abs() + root
+                let (k1, k2) = c.principal();
+                k1.abs().max(k2.abs())
             }
             _ => f64::INFINITY,
         };

@@ -162,10 +162,11 @@ impl SurfaceJet {
     }
     /// The principal curvatures κ₁ ≥ κ₂ (H ± √(H² − K), with respect to [`SurfaceJet::normal`]).
     pub fn principal_curvatures(&self) -> (f64, f64) {
-        let (k, h) = (self.gaussian_curvature(), self.mean_curvature());
-        // H² ≥ K holds exactly; rounding can make the difference a hair negative at umbilics.
-        let root = (h * h - k).max(0.0).sqrt();
-        (h + root, h - root)
+        crate::evaluate::Curvatures {
+            gaussian: self.gaussian_curvature(),
+            mean: self.mean_curvature(),
+        }
+        .principal()
     }
     /// The area element |S_u × S_v|.
     pub fn area_element(&self) -> f64 {
