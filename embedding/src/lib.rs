@@ -63,6 +63,10 @@ pub enum EmbeddingError {
     ControlCount { found: usize, expected: usize },
     #[error("control point {0} has a coordinate that is not a finite number")]
     NotFinite(usize),
+    #[error(
+        "control point {index} has a coordinate of {value:e}, beyond the ±{max:e} a model may hold"
+    )]
+    OutOfRange { index: usize, value: f64, max: f64 },
     #[error("constraint {0} asks for a position that is not a finite point")]
     BadTarget(usize),
     #[error("the edit's constraints could not be solved")]

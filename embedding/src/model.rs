@@ -9,6 +9,13 @@ use crate::surface::{Layout, Point3, SplineSettings};
 pub const MODEL_FORMAT: &str = "ntori-model";
 pub const MODEL_VERSION: u32 = 1;
 
+/// The largest magnitude a control point coordinate may have in a model. Fitted models are a few
+/// units across; 10⁹ leaves room for any sensible scale while keeping every product the
+/// evaluation forms (squared lengths, cross products of tangents) far inside f64's range and
+/// every position inside the 32-bit floats of exports and the GPU (±3.4e38). A coordinate of
+/// 1e300 would load, draw nothing and export `inf`; beyond this bound a model is refused.
+pub const MAX_COORDINATE: f64 = 1e9;
+
 /// A surface: genus, spline settings and every chart's control points (in [`Layout`] order).
 /// Unknown fields are refused: a misspelt field would otherwise be ignored without a word.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -72,8 +79,27 @@ impl Model {
             .collect()
     }
 
-    /// Checks the header, the settings and the control point count against `layout`, and that every
-    /// coordinate is finite.
+    /// Checks every control point: its coordinates are finite ([`EmbeddingError::NotFinite`]) and
+    /// at most [`MAX_COORDINATE`] in magnitude ([`EmbeddingError::OutOfRange`]); the error names the
+    /// first offending point's index.
+    pub fn check_control_points(&self) -> Result<(), EmbeddingError> {
+        for (index, p) in self.control_points.iter().enumerate() {
+            if p.iter().any(|x| !x.is_finite()) {
+                return Err(EmbeddingError::NotFinite(index));
+            }
+            if let Some(&value) = p.iter().find(|x| x.abs() > MAX_COORDINATE) {
+                return Err(EmbeddingError::OutOfRange {
+                    index,
+                    value,
+                    max: MAX_COORDINATE,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the header, the settings and the control point count against `layout`, and every
+    /// control point ([`Model::check_control_points`]).
     pub fn validate(&self, layout: &Layout) -> Result<(), EmbeddingError> {
         ModelHeader {
             format: self.format.clone(),
@@ -89,13 +115,6 @@ impl Model {
                 expected: layout.control_count(),
             });
         }
-        if let Some(i) = self
-            .control_points
-            .iter()
-            .position(|p| p.iter().any(|x| !x.is_finite()))
-        {
-            return Err(EmbeddingError::NotFinite(i));
-        }
-        Ok(())
+        self.check_control_points()
     }
 }

@@ -3,11 +3,13 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use ntori::io::export::{self, Encoding, ExportError, Format};
+use ntori::io::export::{
+    self, DEFAULT_UNITS, Encoding, ExportError, ExportOptions, Format, Units, Up, UvLayout,
+};
 
 use super::write_stdout;
 
-/// Export a model's surface as a triangle mesh: OBJ, PLY, STL, GLB or OFF.
+/// Export a model's surface as a triangle mesh: OBJ, PLY, STL, GLB, 3MF or OFF.
 ///
 /// The surface is tessellated with the t_e/t_r scheme (see `ntori tessellate --help`; about
 /// 4n·t_e² + 8n·t_e·(2t_r − 1) triangles at genus n ≥ 1) and evaluated at every vertex: the
@@ -15,22 +17,45 @@ use super::write_stdout;
 /// outside), and the vertex's home chart and its coordinates there. The format comes from the
 /// output's extension unless --format names it. What each format carries:
 ///   .obj  positions, normals, texture coordinates (text; OBJ cannot carry the chart id)
-///   .ply  positions, normals, texture coordinates u v, the chart id as `chart`
+///   .ply  positions, normals, texture coordinates `s t`, the chart id as `chart`
 ///         (binary little endian, or text with --ascii)
 ///   .stl  triangles with one face normal each; no shared vertices, no texture coordinates
 ///         (binary, or text with --ascii)
 ///   .glb  binary glTF 2.0: POSITION, NORMAL, TEXCOORD_0 (f32; v flipped, as glTF's textures
-///         start at the top), the chart id as the custom attribute _CHART (u16), u32 indices
+///         start at the top), the chart id as the custom attribute _CHART (u8), u32 indices,
+///         and a PBR material whose base colour is a checker texture drawn through TEXCOORD_0
+///   .3mf  3MF, for slicers: one object of vertices and triangles, in millimetres
 ///   .off  positions and triangles only (text)
-/// Texture coordinates are the home chart's coordinates moved into [0, 1]²; they are continuous
-/// within one chart, so triangles whose corners have different home charts span a texture seam.
-/// Coordinates are stored as 32-bit floats. The file is written whole or not at all; an existing
-/// file is replaced.
+/// The object is named after the model file (its name without the extension): OBJ's `o`, the
+/// GLB node and mesh, the 3MF object, STL's `solid` (the binary header), a PLY or OFF comment.
+///
+/// Size: one model unit becomes S U (--scale S, --units U), by default 1 cm, so the default
+/// genus-2 model (about 5.4 units across) is a 5.4 cm object whatever the format. Formats with
+/// a unit are written in it: GLB in metres (glTF's unit), 3MF in millimetres (it declares
+/// them), STL in millimetres (it has no field for a unit; slicers read millimetres). OBJ, PLY
+/// and OFF have no unit: their numbers are S times the model's, meaning U (a comment says so).
+///
+/// Up: z is the model's up (its plates lie in the xy plane). Each format gets what its readers
+/// expect unless --up says otherwise: +y for GLB (glTF's specification) and OBJ (Blender and
+/// most viewers), +z for PLY, STL, 3MF and OFF. +y up turns the model by −90° about x,
+/// (x, y, z) → (x, z, −y): a rotation, so triangles and normals still face outward.
+///
+/// Texture coordinates (--uv): `chart`, the default, moves each vertex's home chart
+/// coordinates into [0, 1]²; they are continuous within one chart only, so every chart covers
+/// the same square and triangles whose corners have different home charts span a seam.
+/// `atlas` packs each chart's region into its own tile of a grid in [0, 1]² and splits the
+/// mesh along the seams (a vertex on triangles of two charts is written twice, at the same
+/// position, with the chart id of its tile), so a texture can be painted and baked; for OBJ,
+/// PLY and GLB, the formats with texture coordinates.
+///
+/// Coordinates are stored as 32-bit floats. The file is written whole or not at all; an
+/// existing file is replaced.
 ///
 /// Examples:
 ///   ntori export model.json -o surface.obj
 ///   ntori export model.json -o surface.ply --te 32 --tr 32 --ascii
-///   ntori export model.json -o print.stl
+///   ntori export model.json -o print.3mf --scale 2      (the default model, 108 mm across)
+///   ntori export model.json -o paint.glb --uv atlas
 #[derive(clap::Args, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
@@ -43,9 +68,9 @@ pub struct Args {
     /// The file format, overriding the output's extension.
     #[arg(long, value_enum)]
     format: Option<Format>,
-    /// Divisions of each edge chart's square (and each arc), 1 to 512. At 1 two different edges
-    /// can join the same two vertices, which tools that know edges by their endpoints take for
-    /// a non-manifold mesh. Too coarse a tessellation folds (a warning says so).
+    /// Divisions of each edge chart's square (and each arc), 1 to 512. 1 is refused at genus
+    /// ≥ 1: there two different edges would join the same two vertices, which mesh readers take
+    /// for a non-manifold mesh. Too coarse a tessellation folds (a warning says so).
     #[arg(long, default_value_t = 16, value_name = "A", allow_negative_numbers = true,
           value_parser = clap::value_parser!(u32).range(1..=i64::from(export::MAX_RESOLUTION)))]
     te: u32,
@@ -56,9 +81,45 @@ pub struct Args {
     /// Write PLY or STL as text instead of binary.
     #[arg(long)]
     ascii: bool,
+    /// The file's up axis [default: y for GLB and OBJ, z for the others].
+    #[arg(long, value_enum, value_name = "AXIS")]
+    up: Option<Up>,
+    /// One model unit becomes S units (--units): a finite number above 0.
+    #[arg(long, default_value_t = 1.0, value_name = "S", allow_negative_numbers = true,
+          value_parser = parse_scale)]
+    scale: f64,
+    /// The unit a model unit (times --scale) is measured in; GLB, STL and 3MF are converted to
+    /// their own unit, OBJ, PLY and OFF store numbers in this one.
+    #[arg(long, value_enum, default_value_t = DEFAULT_UNITS, value_name = "U")]
+    units: Units,
+    /// Texture coordinates: each vertex's home chart's, or a packed atlas split at seams.
+    #[arg(long, value_enum, default_value_t = UvLayout::Chart, value_name = "LAYOUT")]
+    uv: UvLayout,
     /// Print nothing on success.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// A scale: a finite number above 0 (0 would collapse the mesh, a negative one turn it inside
+/// out).
+fn parse_scale(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        Ok(x) => Err(format!(
+            "the scale must be a finite number above 0, got {x}"
+        )),
+        Err(_) => Err(format!("the scale must be a number, got {s:?}")),
+    }
+}
+
+/// `x` with about four significant digits.
+fn significant(x: f64) -> String {
+    let decimals = if x > 0.0 {
+        (3 - x.log10().floor() as i32).clamp(0, 12) as usize
+    } else {
+        0
+    };
+    format!("{x:.decimals$}")
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -69,6 +130,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         te,
         tr,
         ascii,
+        up,
+        scale,
+        units,
+        uv,
         quiet,
     } = args;
     let output: &Path = &output;
@@ -76,18 +141,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(f) => f,
         None => Format::from_path(output)?,
     };
-    if ascii && !format.has_encodings() {
-        return Err(ExportError::NoEncodings(format).into());
-    }
     let encoding = if ascii {
         Encoding::Ascii
     } else {
         Encoding::Binary
     };
+    let options = ExportOptions {
+        encoding,
+        up,
+        scale,
+        units,
+        uv,
+        name: model_path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned()),
+    };
+    options.check(format)?;
     ntori::io::atomic::check_output(output, &[&model_path])?;
     let model = ntori::io::model_file::load(&model_path)?;
     export::check_resolution(model.genus(), te, tr)?;
-    let exported = export::export_surface(&model, (te, tr), output, format, encoding).map_err(
+    let exported = export::export_surface(&model, (te, tr), output, format, &options).map_err(
         |e| match e {
             // Writing failed: the file error says which file and why.
             ExportError::File(_) | ExportError::GlbTooLarge(_) => anyhow::Error::new(e),
@@ -110,12 +183,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             (true, Encoding::Binary) => " (binary)".into(),
             (true, Encoding::Ascii) => " (text)".into(),
         };
+        let [x, y, z] = exported.size.map(significant);
         write_stdout(&format!(
-            "wrote {}: {format}{kind}, genus {}, t_e = {te}, t_r = {tr}, {} vertices, {} triangles\n",
+            "wrote {}: {format}{kind}, genus {}, t_e = {te}, t_r = {tr}, {} vertices, {} triangles, \
+             {x} × {y} × {z} {}\n",
             output.display(),
             model.genus(),
             exported.vertices,
-            exported.triangles
+            exported.triangles,
+            exported.unit.symbol()
         ))?;
     }
     Ok(ExitCode::SUCCESS)

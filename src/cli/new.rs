@@ -9,7 +9,7 @@ use embedding::fit::{FitSettings, InitialFit, initial_model_with_progress};
 use embedding::holed::HoledMesh;
 use embedding::integrals::surface_integrals;
 use embedding::{SplineSettings, Surface};
-use ntori::io::export::{self, Encoding, Format};
+use ntori::io::export::{self, ExportOptions, Format};
 use serde::Serialize;
 
 use super::report::{Report, emit};
@@ -51,8 +51,9 @@ pub struct Args {
     /// Write the model even if a check fails (the exit status is still 3).
     #[arg(long)]
     keep_failed: bool,
-    /// Also write the mesh the fit targets (OBJ, PLY, STL, GLB or OFF, from the extension), with
-    /// each vertex's fitted chart coordinates as UVs, to compare it with the surface.
+    /// Also write the mesh the fit targets (OBJ, PLY, STL, GLB, 3MF or OFF, from the extension),
+    /// with each vertex's fitted chart coordinates as UVs, to compare it with the surface (placed
+    /// as `ntori export` places it by default).
     #[arg(long, value_name = "FILE")]
     input_mesh: Option<PathBuf>,
     /// Input mesh resolution: points around each hole (around the equator for the sphere).
@@ -139,7 +140,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // The input mesh is written whatever the checks say: it is what to compare a failed fit with.
     if let Some((path, format)) = &input_mesh {
         let exported = export::input_mesh(genus, &mesh.positions, &mesh.triangles, &points)?;
-        export::write(&exported, path, *format, Encoding::Binary)?;
+        // Placed as `ntori export` places the surface by default, so the two can be compared.
+        let options = ExportOptions {
+            name: Some(format!("ntori genus-{genus} input mesh")),
+            ..ExportOptions::default()
+        };
+        export::write(&exported, path, *format, &options)?;
         if !quiet && !json {
             eprintln!("ntori: wrote the input mesh to {}", path.display());
         }

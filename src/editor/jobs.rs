@@ -10,7 +10,7 @@ use embedding::fit::{FitSettings, initial_model};
 use embedding::{EmbeddingError, Point3, SplineSettings, Surface};
 
 use super::state::{EditorError, refit};
-use crate::io::export::{self, Encoding, ExportError, Format};
+use crate::io::export::{self, ExportError, Format};
 
 /// Resolution of the input meshes of new models (points around each hole), as `ntori new` uses.
 const NEW_MODEL_RESOLUTION: usize = 32;
@@ -121,8 +121,8 @@ impl Jobs {
     pub fn export(&mut self, surface: Surface, (te, tr): (u32, u32), path: PathBuf) {
         self.spawn("exporting".into(), move || {
             let format = Format::from_path(&path)?;
-            let exported =
-                export::export_surface(&surface, (te, tr), &path, format, Encoding::Binary)?;
+            let options = export::ExportOptions::default();
+            let exported = export::export_surface(&surface, (te, tr), &path, format, &options)?;
             Ok(JobOutput::Exported { exported, path })
         });
     }

@@ -16,7 +16,7 @@
 //! one behind; the next write into the same directory removes those whose process is gone and that
 //! are older than [`STALE_AFTER`].
 
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -61,16 +61,22 @@ pub const STALE_AFTER: Duration = Duration::from_secs(10 * 60);
 /// The most symbolic links followed from one output path (as Linux's ELOOP).
 const MAX_LINKS: usize = 40;
 
+/// A writer that can also seek: what [`write_atomically_with`] hands out (a buffered temporary
+/// file), so formats that go back to fill in lengths (ZIP) can be written through it too.
+pub trait WriteSeek: Write + Seek {}
+
+impl<T: Write + Seek + ?Sized> WriteSeek for T {}
+
 /// Writes `bytes` to `path` atomically (see the module documentation).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     write_atomically_with(path, |w| w.write_all(bytes))
 }
 
 /// Streams a file to `path` atomically: `write` gets a buffered writer into a temporary file beside
-/// the target, which replaces the target only if `write` and the final flush succeed.
+/// the target (seekable), which replaces the target only if `write` and the final flush succeed.
 pub fn write_atomically_with<F>(path: &Path, write: F) -> Result<(), FileError>
 where
-    F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    F: FnOnce(&mut dyn WriteSeek) -> std::io::Result<()>,
 {
     write_file(path, true, write)
 }
@@ -80,7 +86,7 @@ where
 /// rename are one step, so no file created in between is lost).
 pub fn write_new_with<F>(path: &Path, write: F) -> Result<(), FileError>
 where
-    F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    F: FnOnce(&mut dyn WriteSeek) -> std::io::Result<()>,
 {
     write_file(path, false, write)
 }
@@ -154,7 +160,7 @@ pub fn resolve_target(path: &Path) -> Result<PathBuf, FileError> {
 
 fn write_file<F>(path: &Path, replace: bool, write: F) -> Result<(), FileError>
 where
-    F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    F: FnOnce(&mut dyn WriteSeek) -> std::io::Result<()>,
 {
     let target = resolve_target(path)?;
     let dir = directory_of(path, &target)?;

@@ -2,8 +2,9 @@
 //! written atomically.
 //!
 //! [`load`] reads the header (`format`, `version`) before the rest, so a file from a newer ntori is
-//! refused as such rather than as malformed, then builds the [`Surface`] (which checks the model
-//! against the layout its genus and settings define). Every error names the file.
+//! refused as such rather than as malformed, refuses control points beyond
+//! [`embedding::model::MAX_COORDINATE`] (naming the first), then builds the [`Surface`] (which
+//! checks the model against the layout its genus and settings define). Every error names the file.
 
 use std::path::{Path, PathBuf};
 
@@ -51,6 +52,11 @@ pub enum ModelFileError {
     },
     #[error("{} is not a consistent ntori model: {source}", .path.display())]
     Inconsistent {
+        path: PathBuf,
+        source: EmbeddingError,
+    },
+    #[error("cannot write {}: {source}, so it could not be read back", .path.display())]
+    Unloadable {
         path: PathBuf,
         source: EmbeddingError,
     },
@@ -127,10 +133,14 @@ pub fn from_bytes(path: &Path, bytes: &[u8]) -> Result<Surface, ModelFileError> 
     let mut de = serde_json::Deserializer::from_slice(bytes);
     let model: Model = serde_path_to_error::deserialize(&mut de)
         .map_err(|e| not_a_model(describe(e.inner(), Some(&field_path(e.path())))))?;
-    Surface::from_model(&model).map_err(|source| ModelFileError::Inconsistent {
-        path: path.to_owned(),
-        source,
-    })
+    // Absurd coordinates (beyond embedding's MAX_COORDINATE) are refused with the point's index.
+    model
+        .check_control_points()
+        .and_then(|()| Surface::from_model(&model))
+        .map_err(|source| ModelFileError::Inconsistent {
+            path: path.to_owned(),
+            source,
+        })
 }
 
 /// The file's bytes, if it is a regular file of at most [`MAX_MODEL_BYTES`].
@@ -280,6 +290,13 @@ pub fn save_new(path: impl AsRef<Path>, surface: &Surface) -> Result<(), ModelFi
 
 fn model_text(path: &Path, surface: &Surface) -> Result<String, ModelFileError> {
     let model = surface.to_model();
+    // What `load` would refuse is not written.
+    model
+        .check_control_points()
+        .map_err(|source| ModelFileError::Unloadable {
+            path: path.to_owned(),
+            source,
+        })?;
     let mut text = serde_json::to_string(&model).map_err(|source| ModelFileError::Serialize {
         path: path.to_owned(),
         source,

@@ -417,21 +417,25 @@ fn scaled_model(dir: &Path, name: &str, scale: f64, outlier: Option<f64>) -> std
 #[test]
 fn numbers_that_do_not_survive_f32_are_refused_not_written() {
     let dir = tempfile::tempdir().unwrap();
+    // Models beyond ±1e9 (embedding::model::MAX_COORDINATE) are refused when they are read.
     let huge = scaled_model(dir.path(), "huge.json", 1e39, None);
     let outlier = scaled_model(dir.path(), "outlier.json", 1.0, Some(1e155));
     let tiny = scaled_model(dir.path(), "tiny.json", 1e-46, None);
     let fine = scaled_model(dir.path(), "fine.json", 1.0, None);
-    for ext in ["obj", "ply", "stl", "glb", "off"] {
+    for ext in ["obj", "ply", "stl", "glb", "3mf", "off"] {
         let out = dir.path().join(format!("m.{ext}"));
-        for (model, expected) in [
-            (&huge, "beyond the 32-bit floats"),
-            (&outlier, "beyond the 32-bit floats"),
-            (&tiny, "below what the 32-bit floats"),
+        for (model, scale, expected) in [
+            (&huge, "1", "beyond the ±1e9 a model may hold"),
+            (&outlier, "1", "control point 0 has a coordinate of 1e155"),
+            (&tiny, "1", "below what the 32-bit floats"),
+            // A scale (times the unit) past f32's range, or below its resolution.
+            (&fine, "1e42", "beyond the 32-bit floats"),
+            (&fine, "1e-44", "below what the 32-bit floats"),
         ] {
             ntori()
                 .arg("export")
                 .arg(model)
-                .args(["--te", "4", "--tr", "4", "-q", "-o"])
+                .args(["--te", "4", "--tr", "4", "-q", "--scale", scale, "-o"])
                 .arg(&out)
                 .assert()
                 .code(1)
@@ -450,7 +454,7 @@ fn numbers_that_do_not_survive_f32_are_refused_not_written() {
     let png = dir.path().join("m.png");
     let constant = constant_model(dir.path(), 1);
     for (model, expected) in [
-        (&huge, "beyond the 32-bit floats the GPU"),
+        (&huge, "beyond the ±1e9 a model may hold"),
         (&tiny, "below what the GPU's 32-bit floats"),
         (&constant, "the surface is degenerate"),
     ] {
@@ -579,6 +583,12 @@ fn bad_input_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
         ("CONSTANT64".into(), constant64),
         ("CONSTANT".into(), constant),
         ("HUGE".into(), scaled_model(dir, "huge.json", 1e39, None)),
+        (
+            "ABSURD".into(),
+            edit("absurd.json", &|v| {
+                v["control_points"][17][1] = 1e300.into()
+            }),
+        ),
         ("TINY".into(), scaled_model(dir, "tiny.json", 1e-46, None)),
         (
             "NULL".into(),

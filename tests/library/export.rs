@@ -1,7 +1,10 @@
 //! Export: every format written from fitted models of genus 0 to 3 and read back with an independent
-//! reader (tobj, ply-rs-bw's parser, stl_io, gltf, a small OFF parser here), then checked: a closed,
-//! manifold, orientable mesh of the right Euler characteristic, outward, with unit normals that
-//! agree with the faces, at the positions the surface mesh has (to f32 precision).
+//! reader (tobj, ply-rs-bw's parser, stl_io, gltf, zip + roxmltree for 3MF, a small OFF parser
+//! here), then checked: a closed, manifold, orientable mesh of the right Euler characteristic,
+//! outward, with unit normals that agree with the faces, at the positions the surface mesh has once
+//! placed as the format's defaults say (to f32 precision). Also: the up axis, units and scale, the
+//! UV atlas, the chart id's type, object names. (`export_tools.rs` reads the same files with
+//! trimesh, lib3mf and the Khronos glTF validator.)
 
 use std::io::Cursor;
 use std::sync::OnceLock;
@@ -9,7 +12,8 @@ use std::sync::OnceLock;
 use embedding::{Model, Point3, Surface, Vector3};
 use mesh::HalfEdgeMesh;
 use ntori::io::export::{
-    self, Encoding, ExportError, Format, MAX_RESOLUTION, SurfaceMesh, surface_mesh,
+    self, ChartComponent, ChartMesh, Encoding, ExportError, ExportOptions, Format, MAX_RESOLUTION,
+    SurfaceMesh, Units, Up, UvAtlas, UvLayout, surface_mesh,
 };
 use ntori::io::model_file::{self, ModelFileError};
 
@@ -25,16 +29,36 @@ fn meshes() -> &'static [SurfaceMesh] {
     MESHES.get_or_init(|| {
         models()
             .iter()
-            .map(|m| surface_mesh(m, 16, 16).unwrap())
+            .map(|m| surface_mesh(m, (16, 16), UvLayout::Chart).unwrap())
             .collect()
     })
 }
 
+/// The file `export::write` makes of `mesh` with the default options but `encoding`.
 fn write(mesh: &SurfaceMesh, format: Format, encoding: Encoding) -> Vec<u8> {
+    write_with(
+        mesh,
+        format,
+        &ExportOptions {
+            encoding,
+            ..ExportOptions::default()
+        },
+    )
+}
+
+fn write_with(mesh: &SurfaceMesh, format: Format, options: &ExportOptions) -> Vec<u8> {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(format!("surface.{}", format.extension()));
-    export::write(mesh, &path, format, encoding).unwrap();
+    export::write(mesh, &path, format, options).unwrap();
     std::fs::read(&path).unwrap()
+}
+
+/// `mesh` as a `format` file written with the default options holds it (turned to the format's up
+/// axis, scaled to its unit).
+fn placed(mesh: &SurfaceMesh, format: Format) -> SurfaceMesh {
+    let options = ExportOptions::default();
+    mesh.placed(options.up_for(format), options.factor_for(format))
+        .into_owned()
 }
 
 /// A position or a direction as a file stores it (f32), widened.
@@ -211,7 +235,11 @@ fn obj_reads_back_with_tobj() {
         let bytes = write(mesh, Format::Obj, Encoding::Binary);
         let (read, uvs) = obj(&bytes);
         // tobj numbers vertices in the order the faces first use them.
-        let map = check(&read, mesh, &format!("OBJ genus {}", mesh.genus));
+        let map = check(
+            &read,
+            &placed(mesh, Format::Obj),
+            &format!("OBJ genus {}", mesh.genus),
+        );
         check_uvs(&uvs, &map, mesh, false, "OBJ");
     }
 }
@@ -258,11 +286,12 @@ fn ply_reads_back_with_the_ply_parser_in_both_encodings() {
                     })
                     .collect(),
             };
-            let map = check(&read, mesh, &what);
+            let map = check(&read, &placed(mesh, Format::Ply), &what);
             assert_identity(&map, &what);
+            // `s t`: the names Blender and MeshLab read as texture coordinates.
             let uvs: Vec<[f64; 2]> = vertices
                 .iter()
-                .map(|e| [float(e, "u"), float(e, "v")])
+                .map(|e| [float(e, "s"), float(e, "t")])
                 .collect();
             check_uvs(&uvs, &map, mesh, false, &what);
             let charts: Vec<u32> = vertices
@@ -298,7 +327,7 @@ fn stl_reads_back_with_stl_io_in_both_encodings() {
                     .map(|f| f.vertices.map(|i| i as u32))
                     .collect(),
             };
-            check(&read, mesh, &what);
+            check(&read, &placed(mesh, Format::Stl), &what);
             // Face normals: unit, outward (as the winding), and on the side of the analytic normals.
             for (k, f) in stl.faces.iter().enumerate() {
                 let n = vector(f.normal.0);
@@ -357,7 +386,7 @@ fn glb_reads_back_with_gltf_and_is_well_formed() {
                 .collect(),
             positions,
         };
-        let map = check(&read, mesh, &what);
+        let map = check(&read, &placed(mesh, Format::Glb), &what);
         assert_identity(&map, &what);
 
         // POSITION's bounds are exactly the f32 positions' bounds (compared as f32: gltf's JSON
@@ -387,13 +416,33 @@ fn glb_reads_back_with_gltf_and_is_well_formed() {
             .collect();
         check_uvs(&uvs, &map, mesh, true, &what);
 
+        // The chart id as u8 (Blender's importer drops u16 attributes).
         let chart = p.get(&Semantic::Extras("CHART".into())).unwrap();
-        assert_eq!(chart.data_type(), gltf::accessor::DataType::U16);
-        let charts: Vec<u32> = gltf::accessor::Iter::<u16>::new(chart, |_| Some(blob))
+        assert_eq!(chart.data_type(), gltf::accessor::DataType::U8);
+        let charts: Vec<u32> = gltf::accessor::Iter::<u8>::new(chart, |_| Some(blob))
             .unwrap()
             .map(u32::from)
             .collect();
         assert_eq!(charts, mesh.charts, "{what}");
+
+        // A PBR material whose base colour texture is read through TEXCOORD_0: an embedded PNG.
+        let material = p.material();
+        let pbr = material.pbr_metallic_roughness();
+        let info = pbr.base_color_texture().expect("a base colour texture");
+        assert_eq!(info.tex_coord(), 0);
+        assert_eq!(pbr.metallic_factor(), 0.0);
+        let gltf::image::Source::View { view, mime_type } = info.texture().source().source() else {
+            panic!("{what}: the image is not in the buffer");
+        };
+        assert_eq!(mime_type, "image/png");
+        let png = &blob[view.offset()..view.offset() + view.length()];
+        assert_eq!(png, &export::texture::checker_png().unwrap()[..]);
+        let decoder = png::Decoder::new(std::io::Cursor::new(png));
+        let reader = decoder.read_info().unwrap();
+        assert_eq!(
+            (reader.info().width, reader.info().height),
+            (export::texture::SIDE, export::texture::SIDE)
+        );
     }
 }
 
@@ -428,7 +477,7 @@ fn off_reads_back_with_a_plain_parser() {
         let bytes = write(mesh, Format::Off, Encoding::Binary);
         let read = parse_off(std::str::from_utf8(&bytes).unwrap());
         let what = format!("OFF genus {}", mesh.genus);
-        assert_identity(&check(&read, mesh, &what), &what);
+        assert_identity(&check(&read, &placed(mesh, Format::Off), &what), &what);
     }
 }
 
@@ -470,7 +519,7 @@ fn a_mirrored_model_is_still_exported_outward() {
         .map(|p| embedding::Point3::new(-p.x, p.y, p.z))
         .collect();
     let model = original.with_control_points(mirrored).unwrap();
-    let mesh = surface_mesh(&model, 16, 16).unwrap();
+    let mesh = surface_mesh(&model, (16, 16), UvLayout::Chart).unwrap();
     let read = ReadBack {
         positions: mesh.positions.clone(),
         normals: Some(mesh.normals.clone()),
@@ -492,10 +541,14 @@ fn bad_resolutions_and_degenerate_surfaces_are_refused() {
     let model = &models()[2];
     for (te, tr) in [(0, 4), (4, 0), (MAX_RESOLUTION + 1, 4)] {
         assert!(matches!(
-            surface_mesh(model, te, tr),
+            surface_mesh(model, (te, tr), UvLayout::Chart),
             Err(ExportError::Resolution { .. })
         ));
     }
+    assert!(matches!(
+        surface_mesh(model, (1, 4), UvLayout::Chart),
+        Err(ExportError::SharedEdges { genus: 2 })
+    ));
     // Within range but absurd: refused from the formula, before any work.
     let err = export::check_resolution(64, 512, 512).unwrap_err();
     assert!(matches!(err, ExportError::TooManyTriangles { .. }), "{err}");
@@ -511,7 +564,7 @@ fn bad_resolutions_and_degenerate_surfaces_are_refused() {
     let layout = model.layout();
     let point = Model::constant(&layout, embedding::Point3::new(1.0, 2.0, 3.0));
     let point = Surface::from_model(&point).unwrap();
-    let err = surface_mesh(&point, 4, 4).unwrap_err();
+    let err = surface_mesh(&point, (4, 4), UvLayout::Chart).unwrap_err();
     assert!(matches!(err, ExportError::Degenerate { .. }), "{err}");
 }
 
@@ -596,15 +649,538 @@ fn export_surface_writes_what_surface_mesh_makes_and_says_so() {
     for (genus, te, tr) in [(0, 16, 16), (2, 16, 16), (2, 2, 1), (3, 5, 7)] {
         let surface = crate::common::small_model(genus);
         let path = dir.path().join(format!("g{genus}-{te}-{tr}.off"));
+        let options = ExportOptions::default();
         let exported =
-            export::export_surface(surface, (te, tr), &path, Format::Off, Encoding::Ascii).unwrap();
-        let mesh = surface_mesh(surface, te, tr).unwrap();
+            export::export_surface(surface, (te, tr), &path, Format::Off, &options).unwrap();
+        let mesh = surface_mesh(surface, (te, tr), UvLayout::Chart).unwrap();
         assert_eq!(exported.vertices, mesh.positions.len());
         assert_eq!(exported.triangles, mesh.triangles.len());
         assert_eq!(exported.folded, mesh.folded_triangles());
         assert_eq!(
             std::fs::read(&path).unwrap(),
-            write(&mesh, Format::Off, Encoding::Ascii)
+            write(&mesh, Format::Off, Encoding::Binary)
         );
+        // The size it reports is the written mesh's, in the file's unit (OFF: --units, cm).
+        let (lo, hi) = embedding::bounding_box(&mesh.positions);
+        assert_eq!(exported.unit, Units::Cm);
+        for k in 0..3 {
+            assert!((exported.size[k] - (hi[k] - lo[k])).abs() < 1e-12);
+        }
     }
+}
+
+// ------------------------------------------------------------------ up axis, units, scale
+
+#[test]
+fn y_up_is_a_rotation_that_keeps_the_mesh_outward() {
+    let mesh = &meshes()[2];
+    let up = mesh.placed(Up::Y, 1.0).into_owned();
+    // (x, y, z) → (x, z, −y), normals too.
+    for (p, q) in up.positions.iter().zip(&mesh.positions) {
+        assert_eq!([p.x, p.y, p.z], [q.x, q.z, -q.y]);
+    }
+    for (n, m) in up.normals.iter().zip(&mesh.normals) {
+        assert_eq!([n.x, n.y, n.z], [m.x, m.z, -m.y]);
+    }
+    // The triangles are the same, and still face outward: a rotation keeps the signed volume.
+    assert_eq!(up.triangles, mesh.triangles);
+    let (before, after) = (
+        export::signed_volume(&mesh.positions, &mesh.triangles),
+        export::signed_volume(&up.positions, &up.triangles),
+    );
+    assert!(after > 0.0 && (after - before).abs() < 1e-12 * before);
+    let read = ReadBack {
+        positions: up.positions.clone(),
+        normals: Some(up.normals.clone()),
+        triangles: up.triangles.clone(),
+    };
+    check(&read, &up, "genus 2, y up");
+    // The plate's thin axis, z in the model, is y in a Y-up file.
+    let extent = |m: &SurfaceMesh| {
+        let (lo, hi) = embedding::bounding_box(&m.positions);
+        hi - lo
+    };
+    assert_eq!(extent(mesh).imin(), 2);
+    assert_eq!(extent(&up).imin(), 1);
+    // Scaling keeps the orientation too; nothing to do borrows.
+    let big = mesh.placed(Up::Z, 2.5);
+    let volume = export::signed_volume(&big.positions, &big.triangles);
+    assert!((volume / before - 2.5f64.powi(3)).abs() < 1e-9);
+    assert!(matches!(
+        mesh.placed(Up::Z, 1.0),
+        std::borrow::Cow::Borrowed(_)
+    ));
+}
+
+#[test]
+fn each_format_gets_its_up_axis_and_its_unit() {
+    use Format::*;
+    let default = ExportOptions::default();
+    let expected_up = [
+        (Obj, Up::Y),
+        (Glb, Up::Y),
+        (Ply, Up::Z),
+        (Stl, Up::Z),
+        (ThreeMf, Up::Z),
+        (Off, Up::Z),
+    ];
+    for (format, up) in expected_up {
+        assert_eq!(default.up_for(format), up, "{format}");
+        let z = ExportOptions {
+            up: Some(Up::Z),
+            ..ExportOptions::default()
+        };
+        assert_eq!(z.up_for(format), Up::Z, "{format}");
+    }
+    // A model unit is 1 cm by default: 0.01 m in glTF, 10 mm in STL and 3MF, 1 (cm) elsewhere.
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b;
+    for (format, factor) in [
+        (Glb, 0.01),
+        (Stl, 10.0),
+        (ThreeMf, 10.0),
+        (Obj, 1.0),
+        (Ply, 1.0),
+        (Off, 1.0),
+    ] {
+        assert!(close(default.factor_for(format), factor), "{format}");
+    }
+    let inches = ExportOptions {
+        scale: 2.0,
+        units: Units::In,
+        ..ExportOptions::default()
+    };
+    for (format, factor) in [(Glb, 0.0508), (Stl, 50.8), (ThreeMf, 50.8), (Obj, 2.0)] {
+        assert!(close(inches.factor_for(format), factor), "{format}");
+    }
+    assert_eq!(inches.unit_for(Obj), Units::In);
+    assert_eq!(inches.unit_for(Glb), Units::M);
+    assert_eq!(inches.unit_for(ThreeMf), Units::Mm);
+}
+
+#[test]
+fn options_that_do_not_apply_are_refused() {
+    for format in Format::ALL {
+        let atlas = ExportOptions {
+            uv: UvLayout::Atlas,
+            ..ExportOptions::default()
+        };
+        let ascii = ExportOptions {
+            encoding: Encoding::Ascii,
+            ..ExportOptions::default()
+        };
+        assert_eq!(atlas.check(format).is_ok(), format.has_uvs(), "{format}");
+        assert_eq!(
+            ascii.check(format).is_ok(),
+            format.has_encodings(),
+            "{format}"
+        );
+        if !format.has_uvs() {
+            let err = atlas.check(format).unwrap_err();
+            assert!(
+                err.to_string()
+                    .contains("--uv atlas applies to OBJ, PLY and GLB"),
+                "{err}"
+            );
+        }
+    }
+    for scale in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let options = ExportOptions {
+            scale,
+            ..ExportOptions::default()
+        };
+        let err = options.check(Format::Stl).unwrap_err();
+        assert!(matches!(err, ExportError::Scale(_)), "{err}");
+    }
+    // A scale that takes the surface beyond f32 is refused when written, not written as inf.
+    let options = ExportOptions {
+        scale: 1e38,
+        ..ExportOptions::default()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.stl");
+    let err = export::write(&meshes()[1], &path, Format::Stl, &options).unwrap_err();
+    assert!(matches!(err, ExportError::NotStorable { .. }), "{err}");
+    assert!(!path.exists());
+}
+
+#[test]
+fn t_e_1_is_refused_exactly_where_two_edges_would_join_the_same_vertices() {
+    for genus in 0..=3 {
+        let t = charts::Atlas::new(genus).unwrap().tessellate(1, 2).unwrap();
+        // Edges known by their endpoints only, as mesh readers know them.
+        let manifold =
+            HalfEdgeMesh::from_polygons(t.vertices.len(), t.triangles.iter().map(|t| &t[..]))
+                .unwrap()
+                .topology()
+                .manifold;
+        let refused = export::check_resolution(genus, 1, 2).is_err();
+        assert_eq!(manifold, genus == 0, "genus {genus}");
+        assert_eq!(refused, !manifold, "genus {genus}");
+        assert!(export::check_resolution(genus, 2, 1).is_ok());
+    }
+    let err = export::check_resolution(2, 1, 16).unwrap_err();
+    assert!(err.to_string().contains("use --te 2 or more"), "{err}");
+}
+
+// ------------------------------------------------------------------------ chart ids, names
+
+/// The GLB's `_CHART` accessor: its component type and values.
+fn glb_charts(bytes: &[u8]) -> (gltf::accessor::DataType, Vec<f64>) {
+    let gltf = gltf::Gltf::from_slice(bytes).unwrap();
+    let blob = gltf.blob.as_deref().unwrap();
+    let p = gltf.meshes().next().unwrap().primitives().next().unwrap();
+    let chart = p.get(&gltf::Semantic::Extras("CHART".into())).unwrap();
+    let values = match chart.data_type() {
+        gltf::accessor::DataType::U8 => {
+            gltf::accessor::Iter::<u8>::new(chart.clone(), |_| Some(blob))
+                .unwrap()
+                .map(f64::from)
+                .collect()
+        }
+        gltf::accessor::DataType::F32 => {
+            gltf::accessor::Iter::<f32>::new(chart.clone(), |_| Some(blob))
+                .unwrap()
+                .map(f64::from)
+                .collect()
+        }
+        other => panic!("_CHART is {other:?}"),
+    };
+    (chart.data_type(), values)
+}
+
+#[test]
+fn chart_ids_are_u8_while_they_fit_and_f32_beyond() {
+    // ntori's atlases have 2n + 2 charts: 130 at genus 64, so u8 always fits.
+    assert_eq!(charts::Atlas::new(64).unwrap().charts().len(), 130);
+    let mesh = &meshes()[1];
+    assert_eq!(export::chart_component(mesh), ChartComponent::U8);
+    let (kind, values) = glb_charts(&write(mesh, Format::Glb, Encoding::Binary));
+    assert_eq!(kind, gltf::accessor::DataType::U8);
+    assert!(
+        values
+            .iter()
+            .zip(&mesh.charts)
+            .all(|(a, &b)| *a == f64::from(b))
+    );
+    // Ids past 255 (a mesh of more than 256 charts) are stored as f32, exactly.
+    let mut many = mesh.clone();
+    for (i, c) in many.charts.iter_mut().enumerate() {
+        *c = (i % 300) as u32;
+    }
+    assert_eq!(export::chart_component(&many), ChartComponent::F32);
+    let bytes = write(&many, Format::Glb, Encoding::Binary);
+    let (kind, values) = glb_charts(&bytes);
+    assert_eq!(kind, gltf::accessor::DataType::F32);
+    assert!(
+        values
+            .iter()
+            .zip(&many.charts)
+            .all(|(a, &b)| *a == f64::from(b))
+    );
+    gltf::Gltf::from_slice(&bytes).unwrap();
+}
+
+#[test]
+fn one_object_name_in_every_format_that_stores_one() {
+    let mesh = &meshes()[2];
+    let named = |encoding| ExportOptions {
+        name: Some("torus\nof \"two\" <holes>".into()),
+        encoding,
+        ..ExportOptions::default()
+    };
+    // Control characters become spaces.
+    let name = "torus of \"two\" <holes>";
+    assert_eq!(named(Encoding::Binary).object_name(2), name);
+    assert_eq!(
+        ExportOptions::default().object_name(2),
+        "ntori genus-2 surface"
+    );
+    let long = ExportOptions {
+        name: Some("x".repeat(1000)),
+        ..ExportOptions::default()
+    };
+    assert_eq!(long.object_name(2).len(), export::MAX_NAME_CHARS);
+    let text = |format, encoding| {
+        String::from_utf8_lossy(&write_with(mesh, format, &named(encoding))).into_owned()
+    };
+    assert!(text(Format::Obj, Encoding::Binary).contains(&format!("\no {name}\n")));
+    assert!(text(Format::Ply, Encoding::Ascii).contains(&format!("\ncomment object: {name}\n")));
+    assert!(text(Format::Off, Encoding::Binary).contains(&format!("\n# {name}\n")));
+    let stl = text(Format::Stl, Encoding::Ascii);
+    assert!(stl.starts_with(&format!("solid {name}\n")));
+    assert!(stl.ends_with(&format!("endsolid {name}\n")));
+    assert!(text(Format::Stl, Encoding::Binary).starts_with(name));
+    let glb = write_with(mesh, Format::Glb, &named(Encoding::Binary));
+    let gltf = gltf::Gltf::from_slice(&glb).unwrap();
+    assert_eq!(gltf.nodes().next().unwrap().name(), Some(name));
+    assert_eq!(gltf.meshes().next().unwrap().name(), Some(name));
+    let package = read_3mf(&write_with(mesh, Format::ThreeMf, &named(Encoding::Binary)));
+    let doc = roxmltree::Document::parse(&package.model).unwrap();
+    let object = doc
+        .descendants()
+        .find(|n| n.has_tag_name("object"))
+        .unwrap();
+    assert_eq!(object.attribute("name"), Some(name));
+    // A binary STL header never starts with "solid" (readers would take the file for text).
+    let solid = ExportOptions {
+        name: Some("solid torus".into()),
+        ..ExportOptions::default()
+    };
+    assert!(write_with(mesh, Format::Stl, &solid).starts_with(b"_solid torus"));
+}
+
+// ----------------------------------------------------------------------------------- 3MF
+
+/// A 3MF package's parts, as text.
+struct Package {
+    names: Vec<String>,
+    content_types: String,
+    relationships: String,
+    model: String,
+}
+
+fn read_3mf(bytes: &[u8]) -> Package {
+    use std::io::Read as _;
+    let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+    let names = zip.file_names().map(|n| n.unwrap().into_owned()).collect();
+    let mut part = |name: &str| {
+        let mut text = String::new();
+        zip.by_name(name)
+            .unwrap()
+            .read_to_string(&mut text)
+            .unwrap();
+        text
+    };
+    Package {
+        content_types: part("[Content_Types].xml"),
+        relationships: part("_rels/.rels"),
+        model: part(export::MODEL_PART),
+        names,
+    }
+}
+
+#[test]
+fn threemf_is_a_package_of_one_object_in_millimetres() {
+    const CORE: &str = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02";
+    for mesh in meshes() {
+        let what = format!("3MF genus {}", mesh.genus);
+        let options = ExportOptions {
+            scale: 3.0,
+            units: Units::In,
+            ..ExportOptions::default()
+        };
+        let bytes = write_with(mesh, Format::ThreeMf, &options);
+        // The same mesh gives the same bytes (no time stamps).
+        assert_eq!(bytes, write_with(mesh, Format::ThreeMf, &options), "{what}");
+        let package = read_3mf(&bytes);
+        let mut names = package.names.clone();
+        names.sort();
+        assert_eq!(
+            names,
+            ["3D/3dmodel.model", "[Content_Types].xml", "_rels/.rels"],
+            "{what}"
+        );
+        let types = roxmltree::Document::parse(&package.content_types).unwrap();
+        let defaults: Vec<(&str, &str)> = types
+            .descendants()
+            .filter(|n| n.has_tag_name("Default"))
+            .map(|n| {
+                (
+                    n.attribute("Extension").unwrap(),
+                    n.attribute("ContentType").unwrap(),
+                )
+            })
+            .collect();
+        assert!(defaults.contains(&(
+            "model",
+            "application/vnd.ms-package.3dmanufacturing-3dmodel+xml"
+        )));
+        assert!(defaults.contains(&(
+            "rels",
+            "application/vnd.openxmlformats-package.relationships+xml"
+        )));
+        let rels = roxmltree::Document::parse(&package.relationships).unwrap();
+        let rel = rels
+            .descendants()
+            .find(|n| n.has_tag_name("Relationship"))
+            .unwrap();
+        assert_eq!(rel.attribute("Target"), Some("/3D/3dmodel.model"));
+        assert_eq!(
+            rel.attribute("Type"),
+            Some("http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel")
+        );
+
+        let doc = roxmltree::Document::parse(&package.model).unwrap();
+        let model = doc.root_element();
+        assert_eq!(model.tag_name().namespace(), Some(CORE));
+        assert_eq!(model.tag_name().name(), "model");
+        assert_eq!(model.attribute("unit"), Some("millimeter"));
+        let objects: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("object"))
+            .collect();
+        assert_eq!(objects.len(), 1, "{what}");
+        assert_eq!(objects[0].attribute("type"), Some("model"));
+        let id = objects[0].attribute("id").unwrap();
+        let items: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("item"))
+            .collect();
+        assert_eq!(items.len(), 1);
+        assert_eq!(items[0].attribute("objectid"), Some(id));
+        let number =
+            |n: &roxmltree::Node, k: &str| -> f64 { n.attribute(k).unwrap().parse().unwrap() };
+        let read = ReadBack {
+            positions: doc
+                .descendants()
+                .filter(|n| n.has_tag_name("vertex"))
+                .map(|n| Point3::new(number(&n, "x"), number(&n, "y"), number(&n, "z")))
+                .collect(),
+            normals: None,
+            triangles: doc
+                .descendants()
+                .filter(|n| n.has_tag_name("triangle"))
+                .map(|n| ["v1", "v2", "v3"].map(|k| n.attribute(k).unwrap().parse().unwrap()))
+                .collect(),
+        };
+        // In millimetres: a model unit is 3 inches, 76.2 mm; z up.
+        let expected = mesh.placed(Up::Z, 76.2);
+        assert_identity(&check(&read, &expected, &what), &what);
+    }
+}
+
+// ------------------------------------------------------------------------------- UV atlas
+
+#[test]
+fn the_uv_atlas_gives_each_chart_its_own_tile_and_splits_the_seams() {
+    let (te, tr) = (6, 5);
+    for model in models() {
+        let genus = model.genus();
+        let what = format!("atlas genus {genus}");
+        let chart_mode = surface_mesh(model, (te, tr), UvLayout::Chart).unwrap();
+        let mesh = surface_mesh(model, (te, tr), UvLayout::Atlas).unwrap();
+        assert_eq!(mesh.uv_layout, UvLayout::Atlas);
+        let t = model.atlas().tessellate(te, tr).unwrap();
+        let charts = model.atlas().charts().len();
+        let layout = UvAtlas::new(&ChartMesh::from(&t), charts);
+
+        // Tiles are disjoint squares inside [0, 1]².
+        let tiles: Vec<_> = (0..charts as u32).map(|c| layout.tile(c)).collect();
+        for (a, (lo, hi)) in tiles.iter().enumerate() {
+            assert!(
+                lo.iter().chain(hi).all(|x| (0.0..=1.0).contains(x)),
+                "{what}"
+            );
+            assert!(((hi[0] - lo[0]) - (hi[1] - lo[1])).abs() < 1e-15);
+            for (blo, bhi) in &tiles[a + 1..] {
+                let apart = (0..2).any(|k| hi[k] <= blo[k] || bhi[k] <= lo[k]);
+                assert!(apart, "{what}: tiles overlap");
+            }
+        }
+
+        // The same surface: the same triangles at the same positions, the first vertices the
+        // originals, the others copies of them.
+        assert_eq!(mesh.triangles.len(), chart_mode.triangles.len());
+        assert!(
+            mesh.positions.len() > chart_mode.positions.len(),
+            "{what}: no seam split"
+        );
+        assert_eq!(
+            mesh.positions[..chart_mode.positions.len()],
+            chart_mode.positions[..]
+        );
+        for (a, b) in mesh.triangles.iter().zip(&chart_mode.triangles) {
+            for j in 0..3 {
+                assert_eq!(
+                    mesh.positions[a[j] as usize],
+                    chart_mode.positions[b[j] as usize]
+                );
+                assert_eq!(
+                    mesh.normals[a[j] as usize],
+                    chart_mode.normals[b[j] as usize]
+                );
+            }
+        }
+        assert!(export::signed_volume(&mesh.positions, &mesh.triangles) > 0.0);
+
+        // Every triangle lies in its home chart's tile, inside the gutter, at its corners' home
+        // chart coordinates; its vertices carry that chart: no vertex is shared across a seam.
+        let gutter = export::atlas::GUTTER / layout.columns as f64;
+        let mut area_signs = [0usize; 2];
+        for (k, tri) in mesh.triangles.iter().enumerate() {
+            let chart = t.triangle_charts[k];
+            let (lo, hi) = layout.tile(chart.0);
+            for &v in tri {
+                assert_eq!(
+                    mesh.charts[v as usize], chart.0,
+                    "{what}: a vertex spans a seam"
+                );
+                let uv = mesh.uvs[v as usize];
+                for i in 0..2 {
+                    assert!(
+                        uv[i] >= lo[i] + gutter * 0.999 && uv[i] <= hi[i] - gutter * 0.999,
+                        "{what}: {uv:?} outside its tile {lo:?}..{hi:?}"
+                    );
+                }
+            }
+            // The corners' coordinates in the triangle's chart, placed in its tile (the
+            // tessellation's corner order; orientation may have swapped corners 1 and 2).
+            let expected = t.triangle_coords[k].map(|w| layout.uv(chart.0, w));
+            let got = tri.map(|v| mesh.uvs[v as usize]);
+            let same = |order: [usize; 3]| {
+                (0..3).all(|j| {
+                    (got[j][0] - expected[order[j]][0]).abs() < 1e-12
+                        && (got[j][1] - expected[order[j]][1]).abs() < 1e-12
+                })
+            };
+            assert!(same([0, 1, 2]) || same([0, 2, 1]), "{what}: triangle {k}");
+            let [a, b, c] = got;
+            let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            assert!(area != 0.0, "{what}: triangle {k} has no area in the atlas");
+            area_signs[usize::from(area > 0.0)] += 1;
+        }
+        // No triangle is flipped in the atlas: all wind the same way there.
+        assert!(area_signs.contains(&0), "{what}: {area_signs:?}");
+    }
+}
+
+#[test]
+fn the_atlas_reads_back_split_and_the_chart_mode_whole() {
+    let model = crate::common::small_model(2);
+    let mesh = surface_mesh(model, (4, 4), UvLayout::Atlas).unwrap();
+    let options = ExportOptions {
+        uv: UvLayout::Atlas,
+        ..ExportOptions::default()
+    };
+    // OBJ through tobj: vertices and UVs as written; split at the seams, the mesh has boundaries
+    // where the charts meet, and welding by position closes it.
+    let (read, uvs) = obj(&write_with(&mesh, Format::Obj, &options));
+    assert_eq!(read.positions.len(), mesh.positions.len());
+    assert_eq!(uvs.len(), mesh.uvs.len());
+    let topology =
+        HalfEdgeMesh::from_polygons(read.positions.len(), read.triangles.iter().map(|t| &t[..]))
+            .unwrap()
+            .topology();
+    assert!(!topology.closed);
+    let chart_mode = surface_mesh(model, (4, 4), UvLayout::Chart).unwrap();
+    // Each vertex replaced by the first at its position, then numbered densely.
+    let mut number = std::collections::HashMap::new();
+    let welded: Vec<[u32; 3]> = read
+        .triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                let p = read.positions[v as usize];
+                let first = read.positions.iter().position(|q| *q == p).unwrap();
+                let next = number.len() as u32;
+                *number.entry(first).or_insert(next)
+            })
+        })
+        .collect();
+    assert_eq!(number.len(), chart_mode.positions.len());
+    let topology = HalfEdgeMesh::from_polygons(number.len(), welded.iter().map(|t| &t[..]))
+        .unwrap()
+        .topology();
+    assert!(topology.closed && topology.manifold);
+    assert_eq!(topology.euler_characteristic, -2);
 }

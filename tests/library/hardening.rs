@@ -225,6 +225,63 @@ fn fits_beyond_the_memory_cap_are_refused_before_fitting() {
     assert!(mesh.triangles.len() <= MAX_FIT_TRIANGLES);
 }
 
+#[test]
+fn absurd_control_points_are_refused_at_load_with_their_index() {
+    use embedding::EmbeddingError;
+    use embedding::model::MAX_COORDINATE;
+    use ntori::io::model_file::{self, ModelFileError};
+    let good = small_model(1).to_model();
+    let path = std::path::Path::new("absurd.json");
+    let with = |index: usize, value: f64| {
+        let mut model = good.clone();
+        model.control_points[index][1] = value;
+        model
+    };
+    for (index, value) in [(5, 1e300), (17, -1e10), (0, MAX_COORDINATE * (1.0 + 1e-15))] {
+        let model = with(index, value);
+        assert_eq!(
+            model.check_control_points(),
+            Err(EmbeddingError::OutOfRange {
+                index,
+                value,
+                max: MAX_COORDINATE
+            })
+        );
+        let layout = small_model(1).layout();
+        assert!(model.validate(&layout).is_err());
+        let text = serde_json::to_string(&model).unwrap();
+        let err = model_file::from_bytes(path, text.as_bytes()).unwrap_err();
+        assert!(matches!(err, ModelFileError::Inconsistent { .. }), "{err}");
+        let message = err.to_string();
+        assert!(
+            message.contains(&format!(
+                "control point {index} has a coordinate of {value:e}"
+            )) && message.contains("absurd.json"),
+            "{message}"
+        );
+    }
+    // The bound itself loads.
+    let edge = with(3, -MAX_COORDINATE);
+    assert_eq!(edge.check_control_points(), Ok(()));
+    let text = serde_json::to_string(&edge).unwrap();
+    model_file::from_bytes(path, text.as_bytes()).unwrap();
+    // Non-finite coordinates keep their own error.
+    assert_eq!(
+        with(2, f64::NAN).check_control_points(),
+        Err(EmbeddingError::NotFinite(2))
+    );
+    // A surface beyond the bound (an edit can make one) is not saved: it would not load back.
+    let mut points = small_model(1).control_points().to_vec();
+    points[9].x = 1e12;
+    let far = small_model(1).with_control_points(points).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("far.json");
+    let err = model_file::save(&out, &far).unwrap_err();
+    assert!(matches!(err, ModelFileError::Unloadable { .. }), "{err}");
+    assert!(err.to_string().contains("control point 9"), "{err}");
+    assert!(!out.exists());
+}
+
 // ----------------------------------------------------------------------------------- fuzzing
 
 /// Interesting replacements for a number in a model file.

@@ -1,67 +1,121 @@
-//! Export: a model's surface as a triangle mesh, written as OBJ, PLY, STL, GLB or OFF.
+//! Export: a model's surface as a triangle mesh, written as OBJ, PLY, STL, GLB, 3MF or OFF.
 //!
 //! [`surface_mesh`] tessellates the surface with the paper's t_e/t_r scheme (`charts::tessellation`)
-//! and evaluates it at every vertex: the position and the analytic unit normal S_u × S_v / |S_u × S_v|
-//! (not an average of face normals), and the vertex's *home chart* and coordinates there. Triangles
-//! wind counter-clockwise seen from outside, and the normals point outward: the mesh is oriented so
-//! that its signed volume is positive.
+//! and [`evaluate_mesh`] evaluates any such mesh of chart points ([`ChartMesh`]) at every vertex:
+//! the position and the analytic unit normal S_u × S_v / |S_u × S_v| (not an average of face
+//! normals), and the vertex's *home chart* and coordinates there. Triangles wind counter-clockwise
+//! seen from outside, and the normals point outward: the mesh is oriented so that its signed volume
+//! is positive.
 //!
 //! What each format carries:
 //!
-//! | format | positions | normals | texture coordinates | chart id | encoding |
-//! |--------|-----------|---------|---------------------|----------|----------|
-//! | OBJ    | f32 text  | per vertex (`vn`) | per vertex (`vt`) | no: OBJ has no per-vertex attribute for it | text |
-//! | PLY    | f32       | `nx ny nz` | `u v`           | `chart` (uint) | binary little endian, or `--ascii` |
-//! | STL    | f32, per triangle corner | one per triangle (the face's) | no | no | binary, or `--ascii` |
-//! | GLB    | f32 (with min/max) | `NORMAL` | `TEXCOORD_0` (v flipped, glTF's convention) | `_CHART` (u16) | binary glTF 2.0 |
-//! | OFF    | f32 text  | no      | no                  | no       | text |
+//! | format | positions | normals | texture coordinates | chart id | object name | up | unit |
+//! |--------|-----------|---------|---------------------|----------|-------------|----|------|
+//! | OBJ    | f32 text  | per vertex (`vn`) | per vertex (`vt`) | no: OBJ has no per-vertex attribute for it | `o` | +y | none |
+//! | PLY    | f32       | `nx ny nz` | `s t`            | `chart` (uint) | a comment | +z | none |
+//! | STL    | f32, per triangle corner | one per triangle (the face's) | no | no | `solid` (text), the header (binary) | +z | mm (by convention) |
+//! | GLB    | f32 (with min/max) | `NORMAL` | `TEXCOORD_0` (v flipped), used by a checker base colour texture | `_CHART` (u8; f32 past 256 charts) | node and mesh | +y | m |
+//! | 3MF    | f32 text  | no      | no                  | no       | the object's | +z | mm (declared) |
+//! | OFF    | f32 text  | no      | no                  | no       | a comment   | +z | none |
 //!
-//! Texture coordinates are the vertex's home chart coordinates moved from [−½, ½]² to [0, 1]², so
-//! they are continuous inside one chart only; a triangle whose corners have different home charts
-//! spans a seam of the texture. The chart id (where stored) tells which.
+//! [`ExportOptions`] set the up axis (each format's convention by default; ntori's own up is z),
+//! the size (one model unit becomes `scale` × `units`; formats with a unit are converted to it),
+//! the texture coordinate layout ([`UvLayout`]: each vertex's home chart coordinates moved from
+//! [−½, ½]² to [0, 1]², or a packed atlas with the mesh split at chart seams, see [`atlas`]) and
+//! the object's name.
 //!
 //! Every file is written atomically ([`crate::io::atomic`]): whole, or not at all.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use charts::Tessellation;
+use charts::{ChartId, ChartPoint, Tessellation};
 use embedding::{EmbeddingError, Point3, Sample, Surface, Vector3, Wants, evaluate};
+use num_complex::Complex64;
 
+pub use crate::io::atomic::WriteSeek;
 use crate::io::atomic::{FileError, write_atomically_with};
 
+pub mod atlas;
 mod glb;
 mod obj;
 mod off;
+mod options;
 mod ply;
 mod stl;
+pub mod texture;
+mod threemf;
 
-pub use glb::write_glb;
-pub use obj::write_obj;
-pub use off::write_off;
-pub use ply::write_ply;
-pub use stl::write_stl;
+pub use atlas::UvAtlas;
+pub use glb::{ChartComponent, chart_component};
+use options::FileInfo;
+pub use options::{DEFAULT_UNITS, ExportOptions, MAX_NAME_CHARS, Units, Up, UvLayout};
+pub use threemf::MODEL_PART;
 
 /// The largest t_e and t_r an export accepts.
 pub const MAX_RESOLUTION: u32 = 512;
+/// The most 32-bit rounding may move a vertex, as a fraction of the surface's size (the diagonal of
+/// its bounding box), for an export to be written ([`SurfaceMesh::check_storable`]). A surface about
+/// the origin rounds by about 3e-8 of its size; the bound is reached about 170 sizes away from it.
+pub const MAX_ROUNDING: f64 = 1e-5;
 /// The most triangles an export makes (about 10⁷ vertices: a 1 GB binary STL, 2 GB of OBJ text).
 pub const MAX_TRIANGLES: u64 = 20_000_000;
+
+/// What a [`SurfaceMesh`] was made from, for file headers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MeshSource {
+    /// The t_e/t_r tessellation ([`surface_mesh`]).
+    Tessellation { te: u32, tr: u32 },
+    /// The mesh a fit targets ([`input_mesh`]).
+    FitInput,
+    /// Another mesh of chart points ([`evaluate_mesh`]).
+    #[default]
+    ChartMesh,
+}
 
 /// A tessellated surface with its attributes, ready to write.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SurfaceMesh {
     pub genus: u32,
-    pub te: u32,
-    pub tr: u32,
+    pub source: MeshSource,
+    /// How `uvs` are laid out.
+    pub uv_layout: UvLayout,
     pub positions: Vec<Point3>,
     /// Analytic unit normals, outward.
     pub normals: Vec<Vector3>,
-    /// The vertex's coordinates in its home chart, plus ½: within [0, 1]².
+    /// [`UvLayout::Chart`]: the vertex's coordinates in its home chart, plus ½, within [0, 1]².
+    /// [`UvLayout::Atlas`]: its place in its chart's tile.
     pub uvs: Vec<[f64; 2]>,
-    /// The vertex's home chart.
+    /// The vertex's home chart ([`UvLayout::Atlas`]: the chart of its tile).
     pub charts: Vec<u32>,
     /// Counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
+}
+
+/// A triangle mesh of the surface whose vertices are chart points, borrowed: what
+/// [`evaluate_mesh`] evaluates. The t_e/t_r [`Tessellation`] is one (`ChartMesh::from`); any
+/// other tessellation of the surface can be fed through the same path.
+#[derive(Clone, Copy, Debug)]
+pub struct ChartMesh<'a> {
+    /// Each vertex in its home chart.
+    pub vertices: &'a [ChartPoint],
+    /// Vertex indices, counter-clockwise in the triangle's home chart.
+    pub triangles: &'a [[u32; 3]],
+    /// Each triangle's home chart.
+    pub triangle_charts: &'a [ChartId],
+    /// Each triangle's corners in its home chart's coordinates (the atlas's texture coordinates
+    /// come from these).
+    pub triangle_coords: &'a [[Complex64; 3]],
+}
+
+impl<'a> From<&'a Tessellation> for ChartMesh<'a> {
+    fn from(t: &'a Tessellation) -> Self {
+        ChartMesh {
+            vertices: &t.vertices,
+            triangles: &t.triangles,
+            triangle_charts: &t.triangle_charts,
+            triangle_coords: &t.triangle_coords,
+        }
+    }
 }
 
 /// A file format [`write()`] can produce.
@@ -73,8 +127,11 @@ pub enum Format {
     Ply,
     /// STL: triangles with face normals only (binary or text).
     Stl,
-    /// Binary glTF 2.0: positions, normals, texture coordinates, chart ids.
+    /// Binary glTF 2.0: positions, normals, texture coordinates, chart ids, a material.
     Glb,
+    /// 3MF, for slicers: positions and triangles in millimetres (a ZIP package).
+    #[value(name = "3mf")]
+    ThreeMf,
     /// Object File Format: positions and triangles only (text).
     Off,
 }
@@ -88,11 +145,12 @@ pub enum Encoding {
 }
 
 impl Format {
-    pub const ALL: [Format; 5] = [
+    pub const ALL: [Format; 6] = [
         Format::Obj,
         Format::Ply,
         Format::Stl,
         Format::Glb,
+        Format::ThreeMf,
         Format::Off,
     ];
 
@@ -103,6 +161,7 @@ impl Format {
             Format::Ply => "ply",
             Format::Stl => "stl",
             Format::Glb => "glb",
+            Format::ThreeMf => "3mf",
             Format::Off => "off",
         }
     }
@@ -139,6 +198,12 @@ pub enum ExportError {
     #[error("{name} = {value} is out of range: it must lie in 1..={MAX_RESOLUTION}")]
     Resolution { name: &'static str, value: u32 },
     #[error(
+        "t_e = 1 is refused at genus {genus}: at t_e = 1 some squares of the tessellation share three \
+         corners, so two different edges join the same two vertices, which mesh readers \
+         take for a non-manifold mesh; use --te 2 or more"
+    )]
+    SharedEdges { genus: u32 },
+    #[error(
         "t_e = {te}, t_r = {tr} would make {triangles} triangles at genus {genus}; an export makes \
          at most {MAX_TRIANGLES} (lower t_e or t_r)"
     )]
@@ -161,14 +226,18 @@ pub enum ExportError {
         z: f64,
     },
     #[error(
-        "{} has no known extension (.obj, .ply, .stl, .glb, .off); name one or pass --format",
+        "{} has no known extension (.obj, .ply, .stl, .glb, .3mf, .off); name one or pass --format",
         .path.display()
     )]
     UnknownFormat { path: PathBuf },
     #[error("{0} has no text and binary variants; --ascii applies to PLY and STL only")]
     NoEncodings(Format),
+    #[error("{0} stores no texture coordinates; --uv atlas applies to OBJ, PLY and GLB only")]
+    NoUvs(Format),
+    #[error("the scale must be a finite number above 0, got {0}")]
+    Scale(f64),
     #[error(
-        "vertex {index} lies at ({x:e}, {y:e}, {z:e}), beyond the 32-bit floats {format} stores (±3.4e38); scale the model down"
+        "vertex {index} lies at ({x:e}, {y:e}, {z:e}), beyond the 32-bit floats {format} stores (±3.4e38); lower --scale or scale the model down"
     )]
     NotStorable {
         format: Format,
@@ -178,21 +247,34 @@ pub enum ExportError {
         z: f64,
     },
     #[error(
-        "the surface spans {extent:e}, below what the 32-bit floats {format} stores can tell apart: every vertex would be written at the same point; scale the model up"
+        "the surface spans {extent:e}, below what the 32-bit floats {format} stores can tell apart at up to {magnitude:e} from the origin (they would move its points by up to {error:e}); raise --scale, scale the model up or move it nearer the origin"
     )]
-    Collapses { format: Format, extent: f64 },
+    Collapses {
+        format: Format,
+        extent: f64,
+        /// The largest coordinate's magnitude.
+        magnitude: f64,
+        /// The most f32 rounding moves a coordinate.
+        error: f64,
+    },
     #[error("the mesh needs {0} bytes of GLB, over the format's limit of 4 GiB")]
     GlbTooLarge(u64),
     #[error(transparent)]
     File(#[from] FileError),
+    #[error("cannot write the mesh: {0}")]
+    Write(std::io::Error),
 }
 
 /// How many triangles an export at t_e, t_r makes, or why it is refused (before any work is done).
+/// t_e = 1 is refused at genus ≥ 1 ([`ExportError::SharedEdges`]).
 pub fn check_resolution(genus: u32, te: u32, tr: u32) -> Result<u64, ExportError> {
     for (name, value) in [("t_e", te), ("t_r", tr)] {
         if !(1..=MAX_RESOLUTION).contains(&value) {
             return Err(ExportError::Resolution { name, value });
         }
+    }
+    if te == 1 && genus >= 1 {
+        return Err(ExportError::SharedEdges { genus });
     }
     let triangles = Tessellation::expected_triangles(genus, te, tr);
     if triangles > MAX_TRIANGLES {
@@ -206,42 +288,72 @@ pub fn check_resolution(genus: u32, te: u32, tr: u32) -> Result<u64, ExportError
     Ok(triangles)
 }
 
-/// Tessellates the surface at t_e, t_r and evaluates it (see the module documentation).
-pub fn surface_mesh(surface: &Surface, te: u32, tr: u32) -> Result<SurfaceMesh, ExportError> {
-    let genus = surface.genus();
-    check_resolution(genus, te, tr)?;
-    // The control net's size: derivatives in chart units are of its order. A net of one point has
-    // no surface at all.
-    let size = surface.control_net_size();
-    let control = surface.control_points();
+/// Tessellates the surface at t_e, t_r and evaluates it ([`evaluate_mesh`]) with texture
+/// coordinates laid out as `uv` says.
+pub fn surface_mesh(
+    surface: &Surface,
+    (te, tr): (u32, u32),
+    uv: UvLayout,
+) -> Result<SurfaceMesh, ExportError> {
+    check_resolution(surface.genus(), te, tr)?;
+    check_not_degenerate(
+        surface,
+        Tessellation::expected_vertices(surface.genus(), te, tr),
+    )?;
+    let t = surface
+        .atlas()
+        .tessellate(te, tr)
+        .map_err(EmbeddingError::from)?;
+    let mut mesh = evaluate_mesh(surface, ChartMesh::from(&t), uv)?;
+    mesh.source = MeshSource::Tessellation { te, tr };
+    Ok(mesh)
+}
+
+/// A surface whose control points coincide has no surface to export: refused, naming how many
+/// vertices would have no normal.
+fn check_not_degenerate(surface: &Surface, vertices: u64) -> Result<(), ExportError> {
     if surface.is_degenerate() {
-        let p = control.first().copied().unwrap_or_default();
+        let p = surface
+            .control_points()
+            .first()
+            .copied()
+            .unwrap_or_default();
         return Err(ExportError::Degenerate {
-            count: Tessellation::expected_vertices(genus, te, tr) as usize,
+            count: vertices as usize,
             x: p.x,
             y: p.y,
             z: p.z,
         });
     }
-    let t = surface
-        .atlas()
-        .tessellate(te, tr)
-        .map_err(EmbeddingError::from)?;
-    let n = t.vertices.len();
+    Ok(())
+}
+
+/// Evaluates a mesh of chart points on the surface: each vertex's position, analytic outward
+/// normal (repaired from its triangles where S_u × S_v vanishes), home chart and texture
+/// coordinates ([`UvLayout::Atlas`] splits the mesh at chart seams, see [`atlas`]); triangles
+/// turned outward. Its source is [`MeshSource::ChartMesh`].
+pub fn evaluate_mesh(
+    surface: &Surface,
+    input: ChartMesh<'_>,
+    uv: UvLayout,
+) -> Result<SurfaceMesh, ExportError> {
+    let n = input.vertices.len();
+    check_not_degenerate(surface, n as u64)?;
+    // The control net's size: derivatives in chart units are of its order.
+    let tiny = 1e-9 * surface.control_net_size();
     let mut mesh = SurfaceMesh {
-        genus,
-        te,
-        tr,
+        genus: surface.genus(),
+        source: MeshSource::ChartMesh,
+        uv_layout: UvLayout::Chart,
         positions: Vec::with_capacity(n),
         normals: Vec::with_capacity(n),
         uvs: Vec::with_capacity(n),
         charts: Vec::with_capacity(n),
-        triangles: t.triangles,
+        triangles: input.triangles.to_vec(),
     };
-    let tiny = 1e-9 * size;
     evaluate(
         surface,
-        &t.vertices,
+        input.vertices,
         Wants::default(),
         tiny * tiny,
         &mut |s: &Sample| {
@@ -253,14 +365,28 @@ pub fn surface_mesh(surface: &Surface, te: u32, tr: u32) -> Result<SurfaceMesh, 
             mesh.charts.push(s.point.chart.0);
         },
     );
+    // Repaired on the whole mesh: a seam vertex takes the normals of all its triangles.
     mesh.repair_normals()?;
+    if uv == UvLayout::Atlas {
+        let layout = UvAtlas::new(&input, surface.atlas().charts().len());
+        let split = atlas::split(&input, &layout);
+        for &v in &split.extra {
+            mesh.positions.push(mesh.positions[v as usize]);
+            mesh.normals.push(mesh.normals[v as usize]);
+        }
+        mesh.triangles = split.triangles;
+        mesh.uvs = split.uvs;
+        mesh.charts = split.charts;
+        mesh.uv_layout = UvLayout::Atlas;
+    }
     mesh.orient_outward();
     Ok(mesh)
 }
 
 /// The mesh a fit targets (`ntori new --input-mesh`), as an exportable mesh: its own positions, the
 /// area-weighted normals of its triangles (outward), and as UVs and chart ids the chart point each
-/// vertex was fitted at. Its t_e and t_r are 0 (it is no tessellation of the surface).
+/// vertex was fitted at. Its source is [`MeshSource::FitInput`] (it is no tessellation of the
+/// surface).
 pub fn input_mesh(
     genus: u32,
     positions: &[Point3],
@@ -269,8 +395,8 @@ pub fn input_mesh(
 ) -> Result<SurfaceMesh, ExportError> {
     let mut mesh = SurfaceMesh {
         genus,
-        te: 0,
-        tr: 0,
+        source: MeshSource::FitInput,
+        uv_layout: UvLayout::Chart,
         positions: positions.to_vec(),
         normals: vec![Vector3::repeat(f64::NAN); positions.len()],
         uvs: points
@@ -364,24 +490,29 @@ pub fn signed_volume(positions: &[Point3], triangles: &[[u32; 3]]) -> f64 {
 impl SurfaceMesh {
     /// A one-line description for file headers.
     fn describe(&self) -> String {
-        if self.te == 0 {
-            return format!(
-                "ntori {}: the input mesh of a genus-{} fit, {} vertices, {} triangles",
-                env!("CARGO_PKG_VERSION"),
-                self.genus,
-                self.positions.len(),
-                self.triangles.len()
-            );
-        }
+        let what = match self.source {
+            MeshSource::Tessellation { te, tr } => {
+                format!("genus {}, t_e = {te}, t_r = {tr}", self.genus)
+            }
+            MeshSource::FitInput => format!("the input mesh of a genus-{} fit", self.genus),
+            MeshSource::ChartMesh => format!("genus {}", self.genus),
+        };
         format!(
-            "ntori {}: genus {}, t_e = {}, t_r = {}, {} vertices, {} triangles",
+            "ntori {}: {what}, {} vertices, {} triangles",
             env!("CARGO_PKG_VERSION"),
-            self.genus,
-            self.te,
-            self.tr,
             self.positions.len(),
             self.triangles.len()
         )
+    }
+
+    /// What the texture coordinates are, for file headers.
+    fn describe_uvs(&self) -> &'static str {
+        match self.uv_layout {
+            UvLayout::Chart => "the vertex's home chart coordinates + 0.5",
+            UvLayout::Atlas => {
+                "a packed atlas: each chart's region in its own tile, vertices split at seams"
+            }
+        }
     }
 
     fn position_f32(&self, i: usize) -> [f32; 3] {
@@ -408,10 +539,11 @@ impl SurfaceMesh {
 
     /// Checks that every number `format` stores survives its 32-bit floats: positions within the
     /// f32 range (beyond it they would be written as `inf`, and GLB bounds as `null`), the surface
-    /// not collapsed to one point (a model scaled to 1e-46 rounds to all zeros), and normals,
-    /// STL's face normals among them, finite.
+    /// not blurred by rounding (f32 moves a point by up to half an ulp of its largest coordinate,
+    /// at least 2⁻¹⁵⁰ among the subnormals; that must stay below [`MAX_ROUNDING`] of the surface's
+    /// size: a model scaled to 1e-46 rounds to all zeros, one at 1e-45 to three values), and
+    /// normals, STL's face normals among them, finite.
     pub fn check_storable(&self, format: Format) -> Result<(), ExportError> {
-        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
         for i in 0..self.positions.len() {
             let p = self.position_f32(i);
             if !p.iter().all(|x| x.is_finite()) {
@@ -424,15 +556,23 @@ impl SurfaceMesh {
                     z: q.z,
                 });
             }
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
         }
-        if !self.positions.is_empty() && (0..3).all(|k| lo[k] == hi[k]) {
-            let (plo, phi) = embedding::bounding_box(&self.positions);
-            let extent = (phi - plo).norm();
-            return Err(ExportError::Collapses { format, extent });
+        if !self.positions.is_empty() {
+            let (lo, hi) = embedding::bounding_box(&self.positions);
+            let extent = (hi - lo).norm();
+            let magnitude = self
+                .positions
+                .iter()
+                .fold(0.0f64, |m, p| m.max(p.coords.amax()));
+            let error = (0.5 * magnitude * f64::from(f32::EPSILON)).max(2f64.powi(-150));
+            if !(error <= MAX_ROUNDING * extent) {
+                return Err(ExportError::Collapses {
+                    format,
+                    extent,
+                    magnitude,
+                    error,
+                });
+            }
         }
         let degenerate = |count, i: usize| {
             let q = self.positions[i];
@@ -485,13 +625,17 @@ impl SurfaceMesh {
 }
 
 /// What [`export_surface`] wrote.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Exported {
     pub vertices: usize,
     pub triangles: usize,
     /// Triangles facing against the surface's normals ([`SurfaceMesh::folded_triangles`]): the
     /// tessellation is too coarse for the surface where this is not zero.
     pub folded: usize,
+    /// The bounding box's size along x, y, z as written, in `unit`.
+    pub size: [f64; 3],
+    /// The unit the file's numbers are in.
+    pub unit: Units,
 }
 
 /// The export behind `ntori export` and the editor's: tessellates and evaluates `surface` at
@@ -501,44 +645,67 @@ pub fn export_surface(
     (te, tr): (u32, u32),
     path: &Path,
     format: Format,
-    encoding: Encoding,
+    options: &ExportOptions,
 ) -> Result<Exported, ExportError> {
-    let mesh = surface_mesh(surface, te, tr)?;
-    write(&mesh, path, format, encoding)?;
+    options.check(format)?;
+    let mesh = surface_mesh(surface, (te, tr), options.uv)?;
+    let size = write(&mesh, path, format, options)?;
     Ok(Exported {
         vertices: mesh.positions.len(),
         triangles: mesh.triangles.len(),
         folded: mesh.folded_triangles(),
+        size,
+        unit: options.unit_for(format),
     })
 }
 
-/// Writes `mesh` to `path` atomically in `format` (`encoding` matters for PLY and STL only).
+/// Writes `mesh` to `path` atomically in `format`, placed as `options` say (up axis, scale and
+/// unit; the mesh's texture coordinates are written as they are). Returns the bounding box's size
+/// as written.
 pub fn write(
     mesh: &SurfaceMesh,
     path: &Path,
     format: Format,
-    encoding: Encoding,
-) -> Result<(), ExportError> {
-    mesh.check_storable(format)?;
+    options: &ExportOptions,
+) -> Result<[f64; 3], ExportError> {
+    options.check(format)?;
+    let placed = mesh.placed(options.up_for(format), options.factor_for(format));
+    placed.check_storable(format)?;
     if format == Format::Glb {
-        glb::glb_size(mesh)?;
+        glb::glb_size(&placed)?;
     }
-    write_atomically_with(path, |out| write_to(mesh, format, encoding, out))?;
-    Ok(())
+    let info = FileInfo::new(mesh, format, options);
+    write_atomically_with(path, |out| write_placed(&placed, format, &info, out))?;
+    let (lo, hi) = embedding::bounding_box(&placed.positions);
+    Ok((hi - lo).into())
 }
 
-/// Writes `mesh` in `format` to any writer.
+/// Writes `mesh` in `format` to any seekable writer, placed as `options` say (see [`write()`]).
 pub fn write_to(
     mesh: &SurfaceMesh,
     format: Format,
-    encoding: Encoding,
-    out: &mut dyn Write,
+    options: &ExportOptions,
+    out: &mut dyn WriteSeek,
+) -> Result<(), ExportError> {
+    options.check(format)?;
+    let placed = mesh.placed(options.up_for(format), options.factor_for(format));
+    placed.check_storable(format)?;
+    let info = FileInfo::new(mesh, format, options);
+    write_placed(&placed, format, &info, out).map_err(ExportError::Write)
+}
+
+fn write_placed(
+    mesh: &SurfaceMesh,
+    format: Format,
+    info: &FileInfo,
+    out: &mut dyn WriteSeek,
 ) -> std::io::Result<()> {
     match format {
-        Format::Obj => write_obj(mesh, out),
-        Format::Ply => write_ply(mesh, encoding, out),
-        Format::Stl => write_stl(mesh, encoding, out),
-        Format::Glb => write_glb(mesh, out),
-        Format::Off => write_off(mesh, out),
+        Format::Obj => obj::write_obj(mesh, info, out),
+        Format::Ply => ply::write_ply(mesh, info, out),
+        Format::Stl => stl::write_stl(mesh, info, out),
+        Format::Glb => glb::write_glb(mesh, info, out),
+        Format::ThreeMf => threemf::write_3mf(mesh, info, out),
+        Format::Off => off::write_off(mesh, info, out),
     }
 }

@@ -3,16 +3,19 @@
 use std::io::Write;
 
 use super::SurfaceMesh;
+use super::options::FileInfo;
 
-/// Wavefront OBJ: `v`, `vt`, `vn` per vertex (same index), faces `f a/a/a b/b/b c/c/c`. OBJ has no
-/// per-vertex attribute that could carry the chart id.
-pub fn write_obj(mesh: &SurfaceMesh, out: &mut dyn Write) -> std::io::Result<()> {
+/// Wavefront OBJ: one object (`o` and its name), `v`, `vt`, `vn` per vertex (same index), faces
+/// `f a/a/a b/b/b c/c/c`. OBJ has no per-vertex attribute that could carry the chart id.
+pub fn write_obj(mesh: &SurfaceMesh, info: &FileInfo, out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out, "# {}", mesh.describe())?;
+    writeln!(out, "# {}", info.frame())?;
     writeln!(
         out,
-        "# vt: the vertex's home chart coordinates + 0.5; vn: the analytic unit normal, outward"
+        "# vt: {}; vn: the analytic unit normal, outward",
+        mesh.describe_uvs()
     )?;
-    writeln!(out, "o ntori_genus_{}", mesh.genus)?;
+    writeln!(out, "o {}", info.name)?;
     for i in 0..mesh.positions.len() {
         let [x, y, z] = mesh.position_f32(i);
         writeln!(out, "v {x} {y} {z}")?;

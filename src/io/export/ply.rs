@@ -2,6 +2,7 @@
 
 use std::io::Write;
 
+use super::options::FileInfo;
 use super::{Encoding, SurfaceMesh};
 
 mod records {
@@ -28,8 +29,8 @@ mod records {
                 "nx" => self.normal[0],
                 "ny" => self.normal[1],
                 "nz" => self.normal[2],
-                "u" => self.uv[0],
-                "v" => self.uv[1],
+                "s" => self.uv[0],
+                "t" => self.uv[1],
                 _ => return None,
             })
         }
@@ -51,33 +52,33 @@ mod records {
     }
 }
 
-/// Stanford PLY, binary little endian or ASCII: vertex `x y z nx ny nz u v` (float) and `chart`
-/// (uint); face `vertex_indices` (list uchar int).
-pub fn write_ply(
-    mesh: &SurfaceMesh,
-    encoding: Encoding,
-    out: &mut dyn Write,
-) -> std::io::Result<()> {
+/// Stanford PLY, binary little endian or ASCII: vertex `x y z nx ny nz s t` (float; `s t` are the
+/// texture coordinates, the names Blender and MeshLab read) and `chart` (uint); face
+/// `vertex_indices` (list uchar int). The object's name, up axis and unit are comments.
+pub fn write_ply(mesh: &SurfaceMesh, info: &FileInfo, out: &mut dyn Write) -> std::io::Result<()> {
     use ply_rs_bw::ply::{
         Addable, ElementDef, Encoding as PlyEncoding, Header, PropertyDef, PropertyType, ScalarType,
     };
     use ply_rs_bw::writer::Writer;
 
     let mut header = Header::new();
-    header.encoding = match encoding {
+    header.encoding = match info.encoding {
         Encoding::Ascii => PlyEncoding::Ascii,
         Encoding::Binary => PlyEncoding::BinaryLittleEndian,
     };
+    header.comments.push(format!("object: {}", info.name));
     header.comments.push(mesh.describe());
-    header
-        .comments
-        .push("u v: the vertex's home chart coordinates + 0.5; chart: its home chart".into());
+    header.comments.push(info.frame());
+    header.comments.push(format!(
+        "s t: {}; chart: the vertex's chart",
+        mesh.describe_uvs()
+    ));
     header
         .comments
         .push("nx ny nz: the analytic unit normal, outward".into());
     let mut vertex = ElementDef::new("vertex".into());
     vertex.count = mesh.positions.len();
-    for name in ["x", "y", "z", "nx", "ny", "nz", "u", "v"] {
+    for name in ["x", "y", "z", "nx", "ny", "nz", "s", "t"] {
         vertex.properties.add(PropertyDef::new(
             name.into(),
             PropertyType::Scalar(ScalarType::Float),

@@ -2,17 +2,15 @@
 
 use std::io::Write;
 
+use super::options::FileInfo;
 use super::{Encoding, SurfaceMesh};
 
 /// STL: one facet per triangle with its (outward) face normal; no shared vertices, no attributes.
-pub fn write_stl(
-    mesh: &SurfaceMesh,
-    encoding: Encoding,
-    out: &mut dyn Write,
-) -> std::io::Result<()> {
-    match encoding {
+/// The object's name is the text variant's `solid` name and begins the binary variant's header.
+pub fn write_stl(mesh: &SurfaceMesh, info: &FileInfo, out: &mut dyn Write) -> std::io::Result<()> {
+    match info.encoding {
         Encoding::Ascii => {
-            writeln!(out, "solid ntori")?;
+            writeln!(out, "solid {}", info.name)?;
             for (k, t) in mesh.triangles.iter().enumerate() {
                 let [nx, ny, nz]: [f32; 3] = mesh.face_normal(k).cast::<f32>().into();
                 writeln!(out, "  facet normal {nx:e} {ny:e} {nz:e}")?;
@@ -24,12 +22,18 @@ pub fn write_stl(
                 writeln!(out, "    endloop")?;
                 writeln!(out, "  endfacet")?;
             }
-            writeln!(out, "endsolid ntori")
+            writeln!(out, "endsolid {}", info.name)
         }
         Encoding::Binary => {
-            // An 80-byte header that must not begin with "solid" (readers would take it for text).
+            // An 80-byte header that must not begin with "solid" (readers would take it for text):
+            // the name, then the description, cut at 80 bytes.
             let mut header = [b' '; 80];
-            let text = mesh.describe();
+            let name = if info.name.starts_with("solid") {
+                format!("_{}", info.name)
+            } else {
+                info.name.clone()
+            };
+            let text = format!("{name}; {}", mesh.describe());
             let n = text.len().min(80);
             header[..n].copy_from_slice(&text.as_bytes()[..n]);
             out.write_all(&header)?;
