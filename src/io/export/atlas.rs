@@ -15,14 +15,22 @@ use super::ChartMesh;
 /// The empty margin on each side of a chart's region, as a fraction of its tile.
 pub const GUTTER: f64 = 1.0 / 32.0;
 
+/// Where a chart's region goes: its lower corner in chart coordinates, the scale to texture units
+/// and the texture point the corner goes to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Placement {
+    from: [f64; 2],
+    scale: f64,
+    to: [f64; 2],
+}
+
 /// Where each chart's region goes in [0, 1]².
 #[derive(Clone, Debug, PartialEq)]
 pub struct UvAtlas {
     /// Tiles per row (and at most as many rows).
     pub columns: u32,
-    /// Per chart: the region's lower corner in chart coordinates, the scale to texture units and
-    /// the texture point it goes to (`None` for a chart without triangles).
-    placements: Vec<Option<([f64; 2], f64, [f64; 2])>>,
+    /// Per chart (`None` for a chart without triangles).
+    placements: Vec<Option<Placement>>,
 }
 
 impl UvAtlas {
@@ -52,8 +60,12 @@ impl UvAtlas {
                 let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
                 let scale = if extent > 0.0 { room / extent } else { 0.0 };
                 // Centred in the tile.
-                let at = [0, 1].map(|k| tile_lo[k] + 0.5 * (side - scale * (hi[k] - lo[k])));
-                (lo, scale, at)
+                let to = [0, 1].map(|k| tile_lo[k] + 0.5 * (side - scale * (hi[k] - lo[k])));
+                Placement {
+                    from: lo,
+                    scale,
+                    to,
+                }
             });
             atlas.placements.push(placement);
         }
@@ -71,9 +83,9 @@ impl UvAtlas {
     /// Where chart coordinates `w` of chart `chart` go.
     pub fn uv(&self, chart: u32, w: num_complex::Complex64) -> [f64; 2] {
         match self.placements.get(chart as usize).copied().flatten() {
-            Some((lo, scale, at)) => [
-                at[0] + scale * (w.re - lo[0]),
-                at[1] + scale * (w.im - lo[1]),
+            Some(Placement { from, scale, to }) => [
+                to[0] + scale * (w.re - from[0]),
+                to[1] + scale * (w.im - from[1]),
             ],
             // A chart without triangles: its tile's centre.
             None => {

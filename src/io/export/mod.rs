@@ -565,7 +565,9 @@ impl SurfaceMesh {
                 .iter()
                 .fold(0.0f64, |m, p| m.max(p.coords.amax()));
             let error = (0.5 * magnitude * f64::from(f32::EPSILON)).max(2f64.powi(-150));
-            if !(error <= MAX_ROUNDING * extent) {
+            // False for a NaN extent too: refused.
+            let resolved = error <= MAX_ROUNDING * extent;
+            if !resolved {
                 return Err(ExportError::Collapses {
                     format,
                     extent,
@@ -648,14 +650,17 @@ pub fn export_surface(
     options: &ExportOptions,
 ) -> Result<Exported, ExportError> {
     options.check(format)?;
-    let mesh = surface_mesh(surface, (te, tr), options.uv)?;
-    let size = write(&mesh, path, format, options)?;
+    let mut mesh = surface_mesh(surface, (te, tr), options.uv)?;
+    let info = FileInfo::new(&mesh, format, options);
+    // Placed where it lies (no copy: an export may hold 10⁷ vertices).
+    mesh.place(options.up_for(format), options.factor_for(format));
+    let size = write_placed_file(&mesh, path, format, &info)?;
     Ok(Exported {
         vertices: mesh.positions.len(),
         triangles: mesh.triangles.len(),
         folded: mesh.folded_triangles(),
         size,
-        unit: options.unit_for(format),
+        unit: info.unit,
     })
 }
 
@@ -670,13 +675,22 @@ pub fn write(
 ) -> Result<[f64; 3], ExportError> {
     options.check(format)?;
     let placed = mesh.placed(options.up_for(format), options.factor_for(format));
-    placed.check_storable(format)?;
+    write_placed_file(&placed, path, format, &FileInfo::new(mesh, format, options))
+}
+
+/// Checks and writes a mesh already placed; its bounding box's size.
+fn write_placed_file(
+    mesh: &SurfaceMesh,
+    path: &Path,
+    format: Format,
+    info: &FileInfo,
+) -> Result<[f64; 3], ExportError> {
+    mesh.check_storable(format)?;
     if format == Format::Glb {
-        glb::glb_size(&placed)?;
+        glb::glb_size(mesh)?;
     }
-    let info = FileInfo::new(mesh, format, options);
-    write_atomically_with(path, |out| write_placed(&placed, format, &info, out))?;
-    let (lo, hi) = embedding::bounding_box(&placed.positions);
+    write_atomically_with(path, |out| write_placed(mesh, format, info, out))?;
+    let (lo, hi) = embedding::bounding_box(&mesh.positions);
     Ok((hi - lo).into())
 }
 

@@ -202,13 +202,21 @@ impl SurfaceMesh {
             return Cow::Borrowed(self);
         }
         let mut mesh = self.clone();
-        for p in &mut mesh.positions {
+        mesh.place(up, factor);
+        Cow::Owned(mesh)
+    }
+
+    /// [`SurfaceMesh::placed`] in place.
+    pub fn place(&mut self, up: Up, factor: f64) {
+        if up == Up::Z && factor == 1.0 {
+            return;
+        }
+        for p in &mut self.positions {
             p.coords = up.apply(p.coords) * factor;
         }
-        for n in &mut mesh.normals {
+        for n in &mut self.normals {
             *n = up.apply(*n);
         }
-        Cow::Owned(mesh)
     }
 }
 

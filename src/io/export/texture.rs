@@ -13,7 +13,7 @@ pub fn texel(x: u32, y: u32) -> [u8; 3] {
     let u = (f64::from(x) + 0.5) / f64::from(SIDE);
     let v = 1.0 - (f64::from(y) + 0.5) / f64::from(SIDE);
     let square = SIDE / SQUARES;
-    let light = ((x / square) + (y / square)) % 2 == 0;
+    let light = ((x / square) + (y / square)).is_multiple_of(2);
     let level = if light { 1.0 } else { 0.55 };
     let channel = |c: f64| (255.0 * level * c).round().clamp(0.0, 255.0) as u8;
     [
