@@ -30,6 +30,7 @@ pub mod holed;
 pub mod integrals;
 pub mod model;
 pub mod quality;
+pub mod remesh;
 pub mod spline_surface;
 pub mod stencil;
 pub mod surface;
@@ -85,6 +86,12 @@ pub enum EmbeddingError {
         at_least: bool,
         max: usize,
     },
+    #[error(
+        "a tolerance of {0} is out of range ({min} to {max} of the surface's diagonal)",
+        min = remesh::QualitySettings::MIN_TOLERANCE,
+        max = remesh::QualitySettings::MAX_TOLERANCE
+    )]
+    Tolerance(f64),
     #[error("cannot parameterize the mesh: {0}")]
     Parameterization(String),
     #[error(transparent)]

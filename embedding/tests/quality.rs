@@ -157,3 +157,78 @@ fn normal_deviation_falls_as_the_mesh_refines_and_rises_when_it_is_rough() {
         "{roughened:?} vs {at_32:?}"
     );
 }
+
+/// A small fitted surface of genus `genus` (8×8 control grids, mesh resolution 16).
+fn fitted(genus: u32) -> Surface {
+    let settings = SplineSettings {
+        grid: 8,
+        ..SplineSettings::default()
+    };
+    initial_model(genus, 16, settings, FitSettings::default())
+        .unwrap()
+        .surface
+}
+
+/// The quality tessellation at its defaults, over genus 0 to 10: closed, manifold, χ = 2 − 2n,
+/// outward, ≥ 99% of triangles with every angle ≥ 20° and none ≥ 150°, neighbours bending by at
+/// most 20°, and the chordal error at every triangle's centre within the tolerance.
+#[test]
+fn the_quality_tessellation_is_well_shaped_and_within_tolerance() {
+    use embedding::remesh::{QualitySettings, quality_mesh};
+    let settings = QualitySettings::default();
+    let mut failures = Vec::new();
+    let genera: Vec<u32> = match std::env::var("NTORI_GENERA") {
+        Ok(list) => list.split(',').map(|g| g.parse().unwrap()).collect(),
+        Err(_) => vec![0, 1, 2, 3, 4, 5, 6, 8, 10],
+    };
+    for genus in genera {
+        let s = fitted(genus);
+        let start = std::time::Instant::now();
+        let q = quality_mesh(&s, &settings).unwrap();
+        let elapsed = start.elapsed();
+        let positions: Vec<[f64; 3]> = q.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
+        let topology = mesh::HalfEdgeMesh::from_polygons(
+            positions.len(),
+            q.triangles.iter().map(|t| &t[..]),
+        )
+        .unwrap()
+        .topology();
+        assert!(topology.closed && topology.manifold && topology.orientable, "genus {genus}");
+        assert_eq!(topology.euler_characteristic, 2 - 2 * genus as i64, "genus {genus}");
+        let shape = mesh::mesh_shape(&positions, &q.triangles).unwrap();
+        let diagonal = s.control_net_size();
+        let mut worst = 0.0f64;
+        let mut folded = 0;
+        for (t, tri) in q.triangles.iter().enumerate() {
+            let mean = q.triangle_coords[t].iter().sum::<num_complex::Complex64>() / 3.0;
+            let exact = s.eval(charts::ChartPoint::new(q.triangle_charts[t], mean));
+            let [a, b, c] = tri.map(|i| q.positions[i as usize]);
+            let flat = Point3::from((a.coords + b.coords + c.coords) / 3.0);
+            worst = worst.max((exact.pos - flat).norm() / diagonal);
+            if (b - a).cross(&(c - a)).dot(&exact.normal()) <= 0.0 {
+                folded += 1;
+            }
+        }
+        println!(
+            "genus {genus}: {} vertices, {} triangles in {:.2?}; angles {:.1}°–{:.1}°, {:.2}% ≥ 20°, {} ≥ 150°, bend ≤ {:.1}°, chordal error ≤ {:.2e} of the diagonal",
+            q.vertices.len(),
+            q.triangles.len(),
+            elapsed,
+            shape.smallest_angle,
+            shape.largest_angle,
+            100.0 * shape.well_shaped(),
+            shape.above_150,
+            shape.largest_bend,
+            worst
+        );
+        let ok = folded == 0
+            && shape.well_shaped() >= 0.99
+            && shape.above_150 == 0
+            && shape.largest_bend <= 20.0
+            && worst <= settings.tolerance;
+        if !ok {
+            failures.push(format!("genus {genus}: {folded} folded, {shape:?}, error {worst:.2e}"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

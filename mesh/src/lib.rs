@@ -22,7 +22,9 @@
 
 pub mod cell_complex;
 pub mod halfedge;
+pub mod shape;
 pub mod spatial;
 
 pub use cell_complex::CellComplex;
 pub use halfedge::{HalfEdgeMesh, MeshError, Topology};
+pub use shape::{MeshShape, mesh_shape};

@@ -1,0 +1,887 @@
+//! A quality tessellation: well-shaped triangles whose size follows the surface's curvature.
+//!
+//! The paper's t_e/t_r scheme (`charts::tessellation`) is regular in the charts, so its triangles
+//! are slivers wherever a chart is stretched on the surface, and its size ignores curvature. This
+//! module remeshes on the surface itself, the isotropic remeshing of Botsch and Kobbelt (2004) with
+//! a curvature-adaptive target edge length:
+//!
+//! 1. start from a coarse t_e/t_r tessellation (a valid closed mesh of the right topology);
+//! 2. repeat: split edges longer than 4/3 of the target length, collapse edges shorter than 4/5 of
+//!    it, flip edges towards valence 6, and move every vertex towards the area-weighted centre of
+//!    its triangles, within the tangent plane;
+//! 3. split edges until every triangle's chordal error (the distance between the flat triangle's
+//!    centre and the surface point at its corners' mean chart coordinates) is within the
+//!    tolerance, then flip edges that are not locally Delaunay where that keeps the error.
+//!
+//! Every vertex stays a chart point, kept in its deepest chart: midpoints are taken in a chart
+//! holding both ends, and a vertex moves in chart coordinates (the tangent-plane step pulled back
+//! through the surface's Jacobian), so it never leaves the surface. Stencils, picking and UVs work
+//! on this mesh as on the t_e/t_r one.
+//!
+//! The target edge length at a point with largest principal curvature |κ| is the smallest of
+//! √(3·tol/|κ|) (the chordal error of an equilateral triangle of side L on a sphere of radius R is
+//! about L²/(6R), and edges reach 4/3 of the target), `bend/|κ|` (neighbouring triangles' normals
+//! then differ by about `bend`), and a longest edge; it is graded so it grows by at most
+//! [`GRADATION`] of the distance between neighbours.
+//!
+//! The topology never changes: every operation keeps the mesh closed, manifold and oriented, so
+//! χ = 2 − 2n holds exactly (tested).
+
+use std::collections::{HashMap, HashSet};
+
+use charts::{ChartId, ChartPoint};
+use num_complex::Complex64;
+
+use crate::{EmbeddingError, Point3, Surface, Vector3};
+
+/// How fast the target edge length may grow from one vertex to its neighbour, per unit distance.
+pub const GRADATION: f64 = 0.35;
+
+/// The largest angle (degrees) between neighbouring triangles' normals the remesher leaves: edges
+/// bending more are split.
+pub const MAX_BEND: f64 = 18.0;
+
+/// The most passes of one operation in a row (each pass changes every edge it can; a handful
+/// settle a round).
+const MAX_PASSES: usize = 12;
+
+/// What the quality tessellation aims for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QualitySettings {
+    /// Largest chordal error, as a fraction of the surface's bounding-box diagonal.
+    pub tolerance: f64,
+    /// Angle (radians) the sizing lets the normal turn across one edge.
+    pub bend: f64,
+    /// Longest edge, as a fraction of the diagonal.
+    pub max_edge: f64,
+    /// Rounds of split, collapse, flip and smooth.
+    pub rounds: usize,
+}
+
+impl Default for QualitySettings {
+    fn default() -> Self {
+        QualitySettings {
+            tolerance: 1e-3,
+            bend: 0.22,
+            max_edge: 0.05,
+            rounds: 8,
+        }
+    }
+}
+
+impl QualitySettings {
+    /// The smallest tolerance accepted (below it the triangle counts explode).
+    pub const MIN_TOLERANCE: f64 = 1e-5;
+    /// The largest tolerance accepted.
+    pub const MAX_TOLERANCE: f64 = 0.1;
+
+    /// Checks the settings' ranges.
+    pub fn check(&self) -> Result<(), EmbeddingError> {
+        let t = self.tolerance;
+        if !(Self::MIN_TOLERANCE..=Self::MAX_TOLERANCE).contains(&t) {
+            return Err(EmbeddingError::Tolerance(t));
+        }
+        Ok(())
+    }
+}
+
+/// A tessellation of the surface whose vertices are chart points.
+#[derive(Clone, Debug, Default)]
+pub struct QualityMesh {
+    /// Each vertex in its deepest chart.
+    pub vertices: Vec<ChartPoint>,
+    /// The vertices' positions on the surface.
+    pub positions: Vec<Point3>,
+    /// Counter-clockwise seen from outside (the side S_u × S_v points to).
+    pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's home chart: one holding all three corners, the deepest such.
+    pub triangle_charts: Vec<ChartId>,
+    /// Each triangle's corners in its home chart's coordinates.
+    pub triangle_coords: Vec<[Complex64; 3]>,
+}
+
+/// A vertex being remeshed.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    point: ChartPoint,
+    pos: Point3,
+    /// S_u and S_v in `point`'s chart.
+    du: Vector3,
+    dv: Vector3,
+    normal: Vector3,
+    /// Target edge length here.
+    size: f64,
+}
+
+const DEAD: u32 = u32::MAX;
+
+/// The remesher's state: vertices, triangles, and per pass the adjacency it rebuilds.
+struct Remesher<'a> {
+    surface: &'a Surface,
+    /// Absolute tolerance and edge-length bounds.
+    tolerance: f64,
+    bend: f64,
+    max_edge: f64,
+    min_edge: f64,
+    verts: Vec<Vertex>,
+    tris: Vec<[u32; 3]>,
+    /// Directed edge (a, b) → the triangle holding it; rebuilt every pass.
+    half_edges: HashMap<(u32, u32), u32>,
+    /// Triangles around each vertex; rebuilt every pass.
+    rings: Vec<Vec<u32>>,
+    /// Triangles an operation of this pass changed: the adjacency is stale around them.
+    locked: Vec<bool>,
+    /// Triangles (by corners) whose chordal error is known to be within the tolerance.
+    chordal_fine: HashSet<[u32; 3]>,
+}
+
+/// Remeshes `surface` into a [`QualityMesh`] (see the module documentation).
+pub fn quality_mesh(
+    surface: &Surface,
+    settings: &QualitySettings,
+) -> Result<QualityMesh, EmbeddingError> {
+    settings.check()?;
+    let diagonal = surface.control_net_size();
+    // A coarse start with the right topology; its slivers are remeshed away.
+    let start = surface.atlas().tessellate(8, 8)?;
+    let mut r = Remesher {
+        surface,
+        tolerance: settings.tolerance * diagonal,
+        bend: settings.bend,
+        max_edge: settings.max_edge * diagonal,
+        min_edge: 1e-4 * diagonal,
+        verts: Vec::with_capacity(start.vertices.len()),
+        tris: start.triangles,
+        half_edges: HashMap::new(),
+        rings: Vec::new(),
+        locked: Vec::new(),
+        chordal_fine: HashSet::new(),
+    };
+    for &p in &start.vertices {
+        let v = r.vertex(p).ok_or_else(|| pinched(p))?;
+        r.verts.push(v);
+    }
+    // The t_e/t_r triangles wind counter-clockwise in their charts, which is outward.
+    r.debug("start");
+    for round in 0..settings.rounds {
+        r.grade_sizes();
+        r.repeat(|r| r.split_long());
+        r.debug("split");
+        r.repeat(|r| r.collapse_short());
+        r.debug("collapse");
+        r.repeat(|r| r.flip(FlipRule::Valence));
+        r.debug("flip");
+        // The last rounds only smooth: the connectivity has settled.
+        r.smooth(if round + 1 == settings.rounds { 3 } else { 1 });
+        r.debug("smooth");
+    }
+    r.repeat(|r| r.split_folded());
+    r.debug("folded");
+    r.repeat(|r| r.split_bent());
+    r.debug("bent");
+    r.repeat(|r| r.split_chordal());
+    r.debug("chordal");
+    r.repeat(|r| r.flip(FlipRule::Delaunay));
+    r.debug("delaunay");
+    r.repeat(|r| r.split_chordal());
+    r.debug("final");
+    r.finish()
+}
+
+fn pinched(p: ChartPoint) -> EmbeddingError {
+    EmbeddingError::Parameterization(format!(
+        "the surface has no tangent plane at chart {} ({:.4}, {:.4})",
+        p.chart.0, p.coords.re, p.coords.im
+    ))
+}
+
+/// Triangles that are turned over, or only lie badly.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Folds {
+    /// Clockwise in their chart: the mesh is folded over there. Never made.
+    turned: usize,
+    /// Counter-clockwise, but facing away from the surface's normals by more than 60°: too large or
+    /// too thin for the curvature (a coarse start has such slivers). Never made more of.
+    facing_away: usize,
+}
+
+impl Folds {
+    fn none(&self) -> bool {
+        self.turned == 0 && self.facing_away == 0
+    }
+
+    /// Whether an operation that leaves `self` where there was `before` may go ahead.
+    fn no_worse_than(&self, before: Folds) -> bool {
+        self.turned == 0 && self.facing_away <= before.facing_away
+    }
+}
+
+/// Which flips a pass makes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum FlipRule {
+    /// Towards valence 6.
+    Valence,
+    /// Where the two angles facing the edge sum to more than π (and the chordal error stays).
+    Delaunay,
+}
+
+impl Remesher<'_> {
+    fn debug(&self, stage: &str) {
+        if std::env::var_os("NTORI_REMESH_DEBUG").is_none() {
+            return;
+        }
+        let live: Vec<[u32; 3]> = self.tris.iter().filter(|t| t[0] != DEAD).copied().collect();
+        let pos: Vec<[f64; 3]> = self.verts.iter().map(|v| [v.pos.x, v.pos.y, v.pos.z]).collect();
+        let shape = mesh::mesh_shape(&pos, &live).unwrap();
+        let cw = live.iter().filter(|t| !self.counter_clockwise(**t)).count();
+        let away = live
+            .iter()
+            .filter(|t| !self.faces_outward(**t, t.map(|i| self.pos(i))))
+            .count();
+        let folded = format!("{cw} cw, {away} away");
+        if stage == "final" {
+            for t in live.iter().filter(|t| !self.folds(std::iter::once(**t)).none()).take(6) {
+                let v = t.map(|i| self.verts[i as usize]);
+                eprintln!(
+                    "  folded {t:?}: at {:?}, charts {:?}, coords {:?}, sizes {:?}, normals·n {:?}",
+                    self.centroid(*t),
+                    v.map(|v| v.point.chart.0),
+                    v.map(|v| v.point.coords),
+                    v.map(|v| v.size),
+                    {
+                        let p = v.map(|v| v.pos);
+                        let n = (p[1] - p[0]).cross(&(p[2] - p[0])).normalize();
+                        v.map(|v| n.dot(&v.normal))
+                    }
+                );
+            }
+        }
+        eprintln!(
+            "{stage:>9}: {} tris, folded {folded}, angles {:.1}-{:.1}, {:.2}% ok, {} >150, bend {:.1}",
+            live.len(),
+            shape.smallest_angle,
+            shape.largest_angle,
+            100.0 * shape.well_shaped(),
+            shape.above_150,
+            shape.largest_bend
+        );
+    }
+
+    // ------------------------------------------------------------------ surface points
+
+    /// The surface at `p`, moved to its deepest chart; `None` where the surface has no normal or
+    /// `p` lies outside its chart.
+    fn vertex(&self, p: ChartPoint) -> Option<Vertex> {
+        let atlas = self.surface.atlas();
+        let located = atlas.locate(p).ok()?;
+        let point = *located.representations().iter().max_by(|a, b| {
+            let ma = atlas.charts()[a.chart.index()].domain().margin(a.coords);
+            let mb = atlas.charts()[b.chart.index()].domain().margin(b.coords);
+            ma.total_cmp(&mb)
+        })?;
+        let jet = self.surface.eval(point);
+        let cross = jet.du.cross(&jet.dv);
+        let area = cross.norm();
+        if !(area > 1e-12 * self.max_edge * self.max_edge) {
+            return None;
+        }
+        let (k1, k2) = jet.principal_curvatures();
+        let kappa = k1.abs().max(k2.abs());
+        Some(Vertex {
+            point,
+            pos: jet.pos,
+            du: jet.du,
+            dv: jet.dv,
+            normal: cross / area,
+            size: self.size_for(kappa),
+        })
+    }
+
+    /// The target edge length where the largest principal curvature is `kappa`.
+    fn size_for(&self, kappa: f64) -> f64 {
+        let mut h = self.max_edge;
+        if kappa > 0.0 && kappa.is_finite() {
+            h = h.min((3.0 * self.tolerance / kappa).sqrt());
+            h = h.min(self.bend / kappa);
+        }
+        h.max(self.min_edge)
+    }
+
+    /// Coordinates of the given vertices all in one chart: the deepest chart (by the smallest
+    /// margin) among the vertices' home charts that holds them all.
+    fn common_chart<const N: usize>(&self, ids: [u32; N]) -> Option<(ChartId, [Complex64; N])> {
+        let atlas = self.surface.atlas();
+        let located: Vec<_> = ids
+            .iter()
+            .map(|&i| atlas.locate_unchecked(self.verts[i as usize].point))
+            .collect();
+        let mut best: Option<(f64, ChartId, [Complex64; N])> = None;
+        for &i in &ids {
+            let chart = self.verts[i as usize].point.chart;
+            let domain = atlas.charts()[chart.index()].domain();
+            let mut coords = [Complex64::ZERO; N];
+            let mut margin = f64::INFINITY;
+            let mut all = true;
+            for (k, m) in located.iter().enumerate() {
+                match m.in_chart(chart) {
+                    Some(w) => {
+                        coords[k] = w;
+                        margin = margin.min(domain.margin(w));
+                    }
+                    None => {
+                        all = false;
+                        break;
+                    }
+                }
+            }
+            if all && best.as_ref().is_none_or(|b| margin > b.0) {
+                best = Some((margin, chart, coords));
+            }
+        }
+        best.map(|(_, c, w)| (c, w))
+    }
+
+    /// The surface point at the mean chart coordinates of `ids`.
+    fn centre<const N: usize>(&self, ids: [u32; N]) -> Option<Vertex> {
+        let (chart, coords) = self.common_chart(ids)?;
+        let mean = coords.iter().sum::<Complex64>() / N as f64;
+        self.vertex(ChartPoint::new(chart, mean))
+    }
+
+    /// Distance between the flat triangle's centre and the surface at its corners' mean chart
+    /// coordinates (infinite where no chart holds all three corners).
+    fn chordal_error(&self, t: [u32; 3]) -> f64 {
+        match self.centre(t) {
+            Some(c) => {
+                let flat = self.centroid(t);
+                (c.pos - flat).norm()
+            }
+            None => f64::INFINITY,
+        }
+    }
+
+    fn centroid(&self, t: [u32; 3]) -> Point3 {
+        let [a, b, c] = t.map(|i| self.verts[i as usize].pos.coords);
+        Point3::from((a + b + c) / 3.0)
+    }
+
+    fn pos(&self, i: u32) -> Point3 {
+        self.verts[i as usize].pos
+    }
+
+    /// The edge's length over the mean target length of its ends.
+    fn relative_length(&self, a: u32, b: u32) -> f64 {
+        let (va, vb) = (&self.verts[a as usize], &self.verts[b as usize]);
+        (va.pos - vb.pos).norm() / (0.5 * (va.size + vb.size))
+    }
+
+    /// Whether triangle (a, b, c) with these positions faces the way the surface does at its
+    /// corners (its normal within about 60° of each corner's).
+    fn faces_outward(&self, t: [u32; 3], pos: [Point3; 3]) -> bool {
+        let n = (pos[1] - pos[0]).cross(&(pos[2] - pos[0]));
+        let len = n.norm();
+        if !(len > 0.0) {
+            return false;
+        }
+        t.iter()
+            .all(|&i| n.dot(&self.verts[i as usize].normal) > 0.5 * len)
+    }
+
+    /// How these triangles sit: how many wind clockwise in the chart holding them (or are held by
+    /// none), and how many face away from the surface's normals at their corners.
+    fn folds(&self, tris: impl Iterator<Item = [u32; 3]>) -> Folds {
+        let mut f = Folds::default();
+        for t in tris {
+            if !self.counter_clockwise(t) {
+                f.turned += 1;
+            } else if !self.faces_outward(t, t.map(|i| self.pos(i))) {
+                f.facing_away += 1;
+            }
+        }
+        f
+    }
+
+    /// Whether the triangle winds counter-clockwise in a chart holding all three corners, as the
+    /// start mesh's do: the surface is oriented, so a turned-over triangle winds the other way.
+    fn counter_clockwise(&self, t: [u32; 3]) -> bool {
+        match self.common_chart(t) {
+            Some((_, [a, b, c])) => {
+                let (u, v) = (b - a, c - a);
+                u.re * v.im - u.im * v.re > 0.0
+            }
+            None => false,
+        }
+    }
+
+    /// Makes every target length at most its neighbour's plus [`GRADATION`] times their distance.
+    fn grade_sizes(&mut self) {
+        for _ in 0..4 {
+            let mut changed = false;
+            for t in 0..self.tris.len() {
+                let tri = self.tris[t];
+                if tri[0] == DEAD {
+                    continue;
+                }
+                for k in 0..3 {
+                    let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
+                    let d = (self.verts[a].pos - self.verts[b].pos).norm();
+                    let (sa, sb) = (self.verts[a].size, self.verts[b].size);
+                    if sa > sb + GRADATION * d {
+                        self.verts[a].size = sb + GRADATION * d;
+                        changed = true;
+                    } else if sb > sa + GRADATION * d {
+                        self.verts[b].size = sa + GRADATION * d;
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+    }
+
+    // ------------------------------------------------------------------ connectivity
+
+    /// Rebuilds the adjacency and clears the locks.
+    fn rebuild(&mut self) {
+        self.half_edges.clear();
+        self.rings.clear();
+        self.rings.resize(self.verts.len(), Vec::new());
+        for (t, tri) in self.tris.iter().enumerate() {
+            if tri[0] == DEAD {
+                continue;
+            }
+            for k in 0..3 {
+                self.half_edges
+                    .insert((tri[k], tri[(k + 1) % 3]), t as u32);
+                self.rings[tri[k] as usize].push(t as u32);
+            }
+        }
+        self.locked.clear();
+        self.locked.resize(self.tris.len(), false);
+    }
+
+    /// Runs passes of `pass` (which returns how many operations it made) until one makes none,
+    /// at most [`MAX_PASSES`].
+    fn repeat(&mut self, mut pass: impl FnMut(&mut Self) -> usize) {
+        for _ in 0..MAX_PASSES {
+            self.rebuild();
+            if pass(self) == 0 {
+                break;
+            }
+        }
+    }
+
+    /// The edges (a < b) of the live triangles.
+    fn edges(&self) -> Vec<(u32, u32)> {
+        self.half_edges
+            .keys()
+            .filter(|(a, b)| a < b)
+            .copied()
+            .collect()
+    }
+
+    /// Whether every triangle around these vertices is unchanged in this pass.
+    fn rings_fresh(&self, vertices: &[u32]) -> bool {
+        vertices.iter().all(|&v| {
+            self.rings[v as usize]
+                .iter()
+                .all(|&t| !self.locked[t as usize])
+        })
+    }
+
+    fn lock_rings(&mut self, vertices: &[u32]) {
+        for &v in vertices {
+            for k in 0..self.rings[v as usize].len() {
+                let t = self.rings[v as usize][k];
+                self.locked[t as usize] = true;
+            }
+        }
+    }
+
+    /// The triangles on each side of edge a→b and their third corners: (t₁ = (a, b, c), c) and
+    /// (t₂ = (b, a, d), d).
+    fn edge_wings(&self, a: u32, b: u32) -> Option<(u32, u32, u32, u32)> {
+        let t1 = *self.half_edges.get(&(a, b))?;
+        let t2 = *self.half_edges.get(&(b, a))?;
+        Some((t1, third(self.tris[t1 as usize], a, b), t2, third(self.tris[t2 as usize], b, a)))
+    }
+
+    /// The vertices adjacent to `v` (from its ring, which must be fresh).
+    fn neighbours(&self, v: u32) -> Vec<u32> {
+        let mut n: Vec<u32> = self.rings[v as usize]
+            .iter()
+            .flat_map(|&t| self.tris[t as usize])
+            .filter(|&u| u != v)
+            .collect();
+        n.sort_unstable();
+        n.dedup();
+        n
+    }
+
+    fn valence(&self, v: u32) -> usize {
+        self.rings[v as usize].len()
+    }
+
+    // ------------------------------------------------------------------ operations
+
+    /// Splits, longest first, every edge longer than 4/3 of its target length at its midpoint on
+    /// the surface.
+    fn split_long(&mut self) -> usize {
+        let mut long: Vec<(f64, u32, u32)> = self
+            .edges()
+            .into_iter()
+            .map(|(a, b)| (self.relative_length(a, b), a, b))
+            .filter(|e| e.0 > 4.0 / 3.0)
+            .collect();
+        long.sort_by(|x, y| y.0.total_cmp(&x.0));
+        long.into_iter()
+            .filter(|&(_, a, b)| self.split(a, b))
+            .count()
+    }
+
+    /// Splits every edge across which the triangles' normals turn by more than [`MAX_BEND`].
+    fn split_bent(&mut self) -> usize {
+        let limit = MAX_BEND.to_radians().cos();
+        let normal = |t: u32| {
+            let p = self.tris[t as usize].map(|i| self.pos(i));
+            (p[1] - p[0]).cross(&(p[2] - p[0])).normalize()
+        };
+        let bent: Vec<(u32, u32)> = self
+            .edges()
+            .into_iter()
+            .filter(|&(a, b)| match self.edge_wings(a, b) {
+                // A folded triangle's normal says nothing of the surface's bend.
+                Some((t1, _, t2, _)) => {
+                    normal(t1).dot(&normal(t2)) < limit
+                        && (self.pos(a) - self.pos(b)).norm() > 2.0 * self.min_edge
+                        && self.folds([t1, t2].map(|t| self.tris[t as usize]).into_iter()).none()
+                }
+                None => false,
+            })
+            .collect();
+        bent.into_iter().filter(|&(a, b)| self.split(a, b)).count()
+    }
+
+    /// Splits the longest edge of every triangle whose chordal error exceeds the tolerance.
+    fn split_chordal(&mut self) -> usize {
+        let mut bad = Vec::new();
+        for t in &self.tris {
+            if t[0] == DEAD || self.chordal_fine.contains(t) {
+                continue;
+            }
+            if self.chordal_error(*t) <= self.tolerance {
+                self.chordal_fine.insert(*t);
+                continue;
+            }
+            bad.push(*t);
+        }
+        self.split_longest_edges(bad)
+    }
+
+    /// Splits the longest edge of every triangle that faces away from the surface though it winds
+    /// the right way in its chart: too large for the curvature there.
+    fn split_folded(&mut self) -> usize {
+        let bad: Vec<[u32; 3]> = self
+            .tris
+            .iter()
+            .filter(|t| t[0] != DEAD && self.folds(std::iter::once(**t)).facing_away > 0)
+            .copied()
+            .collect();
+        self.split_longest_edges(bad)
+    }
+
+    fn split_longest_edges(&mut self, tris: Vec<[u32; 3]>) -> usize {
+        let edges: Vec<(u32, u32)> = tris
+            .iter()
+            .map(|t| {
+                let k = (0..3)
+                    .max_by(|&i, &j| {
+                        let li = (self.pos(t[i]) - self.pos(t[(i + 1) % 3])).norm();
+                        let lj = (self.pos(t[j]) - self.pos(t[(j + 1) % 3])).norm();
+                        li.total_cmp(&lj)
+                    })
+                    .unwrap_or(0);
+                (t[k], t[(k + 1) % 3])
+            })
+            .filter(|&(a, b)| (self.pos(a) - self.pos(b)).norm() > self.min_edge)
+            .collect();
+        edges.into_iter().filter(|&(a, b)| self.split(a, b)).count()
+    }
+
+    /// Splits edge a–b at the surface point midway in chart coordinates.
+    fn split(&mut self, a: u32, b: u32) -> bool {
+        let Some((t1, c, t2, d)) = self.edge_wings(a, b) else {
+            return false;
+        };
+        if self.locked[t1 as usize] || self.locked[t2 as usize] {
+            return false;
+        }
+        let Some(mid) = self.centre([a, b]) else {
+            return false;
+        };
+        let m = self.verts.len() as u32;
+        // Halving a triangle in its chart keeps it counter-clockwise; check it all the same.
+        self.verts.push(mid);
+        let children = [[a, m, c], [m, b, c], [b, m, d], [m, a, d]];
+        if children.iter().any(|&t| !self.counter_clockwise(t)) {
+            self.verts.pop();
+            return false;
+        }
+        self.tris[t1 as usize] = [a, m, c];
+        self.tris[t2 as usize] = [b, m, d];
+        self.tris.push([m, b, c]);
+        self.tris.push([m, a, d]);
+        self.locked[t1 as usize] = true;
+        self.locked[t2 as usize] = true;
+        self.locked.extend([true, true]);
+        true
+    }
+
+    /// Collapses, shortest first, every edge shorter than 4/5 of its target length where that
+    /// keeps the mesh a manifold with outward triangles and no edge longer than 4/3.
+    fn collapse_short(&mut self) -> usize {
+        let mut short: Vec<(f64, u32, u32)> = self
+            .edges()
+            .into_iter()
+            .map(|(a, b)| (self.relative_length(a, b), a, b))
+            .filter(|e| e.0 < 4.0 / 5.0)
+            .collect();
+        short.sort_by(|x, y| x.0.total_cmp(&y.0));
+        short
+            .into_iter()
+            .filter(|&(_, a, b)| self.collapse(b, a) || self.collapse(a, b))
+            .count()
+    }
+
+    /// Moves `gone` onto `kept` and removes the two triangles of their edge.
+    fn collapse(&mut self, gone: u32, kept: u32) -> bool {
+        let Some((t1, c, t2, d)) = self.edge_wings(kept, gone) else {
+            return false;
+        };
+        if !self.rings_fresh(&[gone, kept]) {
+            return false;
+        }
+        // The link condition: the ends share exactly the two wing vertices.
+        let (ng, nk) = (self.neighbours(gone), self.neighbours(kept));
+        let shared = ng.iter().filter(|v| nk.binary_search(v).is_ok()).count();
+        if shared != 2 || self.valence(c) <= 3 || self.valence(d) <= 3 {
+            return false;
+        }
+        if self.valence(gone) + self.valence(kept) - 4 > 10 {
+            return false;
+        }
+        let kept_pos = self.pos(kept);
+        let ring = &self.rings[gone as usize];
+        let old_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
+        let changed = ring
+            .iter()
+            .filter(|&&t| t != t1 && t != t2)
+            .map(|&t| self.tris[t as usize].map(|i| if i == gone { kept } else { i }));
+        if !self.folds(changed.clone()).no_worse_than(old_folds) {
+            return false;
+        }
+        // Where nothing was folded, no edge may come out longer than a split would leave.
+        let too_long = |i: u32| {
+            let limit = self.verts[i as usize].size.min(self.verts[kept as usize].size);
+            (self.pos(i) - kept_pos).norm() > 4.0 / 3.0 * limit
+        };
+        if old_folds.none() && changed.flatten().any(|i| i != kept && too_long(i)) {
+            return false;
+        }
+        self.lock_rings(&[gone, kept]);
+        for k in 0..self.rings[gone as usize].len() {
+            let t = self.rings[gone as usize][k] as usize;
+            if t as u32 == t1 || t as u32 == t2 {
+                self.tris[t] = [DEAD; 3];
+            } else {
+                for i in self.tris[t].iter_mut() {
+                    if *i == gone {
+                        *i = kept;
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Flips edges by `rule` where the two new triangles face outward and keep the surface's bend.
+    fn flip(&mut self, rule: FlipRule) -> usize {
+        let mut count = 0;
+        for (a, b) in self.edges() {
+            if self.try_flip(a, b, rule) {
+                count += 1;
+            }
+        }
+        count
+    }
+
+    fn try_flip(&mut self, a: u32, b: u32, rule: FlipRule) -> bool {
+        let Some((t1, c, t2, d)) = self.edge_wings(a, b) else {
+            return false;
+        };
+        if !self.rings_fresh(&[a, b, c, d]) || self.half_edges.contains_key(&(c, d)) {
+            return false;
+        }
+        if self.valence(a) <= 3 || self.valence(b) <= 3 {
+            return false;
+        }
+        let wanted = match rule {
+            FlipRule::Valence => {
+                let dev = |v: u32, delta: i64| {
+                    let x = self.valence(v) as i64 + delta - 6;
+                    x * x
+                };
+                let before = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
+                let after = dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1);
+                after < before
+            }
+            FlipRule::Delaunay => {
+                let angle = |o: u32, p: u32, q: u32| {
+                    let (u, v) = (self.pos(p) - self.pos(o), self.pos(q) - self.pos(o));
+                    u.angle(&v)
+                };
+                angle(c, a, b) + angle(d, b, a) > std::f64::consts::PI + 1e-9
+            }
+        };
+        if !wanted {
+            return false;
+        }
+        let (n1, n2) = ([a, d, c], [d, b, c]);
+        let old_folds = self.folds([[a, b, c], [b, a, d]].into_iter());
+        if !self.folds([n1, n2].into_iter()).no_worse_than(old_folds) {
+            return false;
+        }
+        // The new pair must not bend more than the old one (a flip across a ridge makes a crease).
+        let normal = |t: [u32; 3]| {
+            let p = t.map(|i| self.pos(i));
+            (p[1] - p[0]).cross(&(p[2] - p[0])).normalize()
+        };
+        let old = normal([a, b, c]).dot(&normal([b, a, d]));
+        if old_folds.none() && normal(n1).dot(&normal(n2)) < old.min(0.98) {
+            return false;
+        }
+        if rule == FlipRule::Delaunay
+            && (self.chordal_error(n1) > self.tolerance || self.chordal_error(n2) > self.tolerance)
+        {
+            return false;
+        }
+        self.lock_rings(&[a, b, c, d]);
+        self.tris[t1 as usize] = n1;
+        self.tris[t2 as usize] = n2;
+        true
+    }
+
+    /// Gauss–Seidel sweeps moving each vertex part way towards the area-weighted centre of its
+    /// triangles, within its tangent plane, where no triangle around it turns over.
+    fn smooth(&mut self, sweeps: usize) {
+        self.rebuild();
+        for _ in 0..sweeps {
+            for v in 0..self.verts.len() as u32 {
+                if !self.rings[v as usize].is_empty() {
+                    self.relax(v);
+                }
+            }
+        }
+    }
+
+    fn relax(&mut self, v: u32) {
+        let vert = self.verts[v as usize];
+        let (mut sum, mut weight) = (Vector3::zeros(), 0.0);
+        for &t in &self.rings[v as usize] {
+            let tri = self.tris[t as usize];
+            let p = tri.map(|i| self.pos(i));
+            let area = 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
+            sum += self.centroid(tri).coords * area;
+            weight += area;
+        }
+        if !(weight > 0.0) {
+            return;
+        }
+        let step = (sum / weight - vert.pos.coords) * 0.6;
+        let step = step - vert.normal * step.dot(&vert.normal);
+        // δw minimising |J δw − step|: the normal equations of the 3×2 Jacobian.
+        let (e, f, g) = (
+            vert.du.dot(&vert.du),
+            vert.du.dot(&vert.dv),
+            vert.dv.dot(&vert.dv),
+        );
+        let det = e * g - f * f;
+        if !(det > 0.0) {
+            return;
+        }
+        let (ru, rv) = (vert.du.dot(&step), vert.dv.dot(&step));
+        let dw = Complex64::new((g * ru - f * rv) / det, (e * rv - f * ru) / det);
+        let Some(moved) = self.vertex(ChartPoint::new(vert.point.chart, vert.point.coords + dw))
+        else {
+            return;
+        };
+        let ring = &self.rings[v as usize];
+        let old_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
+        let saved = std::mem::replace(&mut self.verts[v as usize], moved);
+        let new_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
+        self.verts[v as usize] = saved;
+        let ok = new_folds.no_worse_than(old_folds);
+        if ok {
+            self.verts[v as usize] = moved;
+        }
+    }
+
+    // ------------------------------------------------------------------ output
+
+    /// Drops dead triangles and unused vertices, and finds each triangle's home chart.
+    fn finish(self) -> Result<QualityMesh, EmbeddingError> {
+        let mut remap = vec![DEAD; self.verts.len()];
+        let mut mesh = QualityMesh::default();
+        for t in self.tris.iter().filter(|t| t[0] != DEAD) {
+            for &i in t {
+                if remap[i as usize] == DEAD {
+                    remap[i as usize] = mesh.vertices.len() as u32;
+                    mesh.vertices.push(self.verts[i as usize].point);
+                    mesh.positions.push(self.verts[i as usize].pos);
+                }
+            }
+            let (chart, coords) = self.common_chart(*t).ok_or_else(|| {
+                EmbeddingError::Parameterization(format!(
+                    "no chart holds all three corners of a triangle near ({:.3}, {:.3}, {:.3})",
+                    self.centroid(*t).x,
+                    self.centroid(*t).y,
+                    self.centroid(*t).z
+                ))
+            })?;
+            mesh.triangles.push(t.map(|i| remap[i as usize]));
+            mesh.triangle_charts.push(chart);
+            mesh.triangle_coords.push(coords);
+        }
+        Ok(mesh)
+    }
+}
+
+/// The corner of `t` that is neither `a` nor `b`.
+fn third(t: [u32; 3], a: u32, b: u32) -> u32 {
+    t.into_iter().find(|&i| i != a && i != b).unwrap_or(DEAD)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn third_corner() {
+        assert_eq!(third([4, 7, 9], 7, 4), 9);
+        assert_eq!(third([4, 7, 9], 9, 7), 4);
+    }
+
+    #[test]
+    fn tolerance_range_is_checked() {
+        for t in [0.0, -1.0, f64::NAN, 0.5] {
+            let s = QualitySettings {
+                tolerance: t,
+                ..QualitySettings::default()
+            };
+            assert!(s.check().is_err(), "{t}");
+        }
+        assert!(QualitySettings::default().check().is_ok());
+    }
+}
