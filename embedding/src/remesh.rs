@@ -101,9 +101,11 @@ pub struct QualityMesh {
 }
 
 /// A vertex being remeshed.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct Vertex {
     point: ChartPoint,
+    /// Every chart's coordinates of the point (charts hold a point at most once).
+    reps: Vec<ChartPoint>,
     pos: Point3,
     /// S_u and S_v in `point`'s chart.
     du: Vector3,
@@ -141,15 +143,21 @@ pub fn quality_mesh(
     settings: &QualitySettings,
 ) -> Result<QualityMesh, EmbeddingError> {
     settings.check()?;
-    let diagonal = surface.control_net_size();
     // A coarse start with the right topology; its slivers are remeshed away.
     let start = surface.atlas().tessellate(8, 8)?;
+    // The surface's own size (its control net can reach far beyond it).
+    let positions: Vec<Point3> = start
+        .vertices
+        .iter()
+        .map(|&p| surface.eval(p).pos)
+        .collect();
+    let diagonal = crate::fit::diagonal(&positions);
     let mut r = Remesher {
         surface,
         tolerance: settings.tolerance * diagonal,
         bend: settings.bend,
         max_edge: settings.max_edge * diagonal,
-        min_edge: 1e-4 * diagonal,
+        min_edge: 5e-4 * diagonal,
         verts: Vec::with_capacity(start.vertices.len()),
         tris: start.triangles,
         half_edges: HashMap::new(),
@@ -162,29 +170,26 @@ pub fn quality_mesh(
         r.verts.push(v);
     }
     // The t_e/t_r triangles wind counter-clockwise in their charts, which is outward.
-    r.debug("start");
-    for round in 0..settings.rounds {
+    // Clean the start's slivers before refining: splitting a sliver makes more of them.
+    r.repeat(|r| r.collapse_short());
+    r.repeat(|r| r.flip(FlipRule::Valence));
+    r.smooth(2);
+    for _ in 0..settings.rounds {
         r.grade_sizes();
         r.repeat(|r| r.split_long());
-        r.debug("split");
         r.repeat(|r| r.collapse_short());
-        r.debug("collapse");
         r.repeat(|r| r.flip(FlipRule::Valence));
-        r.debug("flip");
-        // The last rounds only smooth: the connectivity has settled.
-        r.smooth(if round + 1 == settings.rounds { 3 } else { 1 });
-        r.debug("smooth");
+        r.smooth(1);
     }
+    // Refine what is still turned away or bent, let the shapes settle, then make sure of the
+    // tolerance.
     r.repeat(|r| r.split_folded());
-    r.debug("folded");
     r.repeat(|r| r.split_bent());
-    r.debug("bent");
-    r.repeat(|r| r.split_chordal());
-    r.debug("chordal");
+    r.smooth(2);
     r.repeat(|r| r.flip(FlipRule::Delaunay));
-    r.debug("delaunay");
+    r.smooth(1);
     r.repeat(|r| r.split_chordal());
-    r.debug("final");
+    r.repeat(|r| r.split_bent());
     r.finish()
 }
 
@@ -226,47 +231,6 @@ enum FlipRule {
 }
 
 impl Remesher<'_> {
-    fn debug(&self, stage: &str) {
-        if std::env::var_os("NTORI_REMESH_DEBUG").is_none() {
-            return;
-        }
-        let live: Vec<[u32; 3]> = self.tris.iter().filter(|t| t[0] != DEAD).copied().collect();
-        let pos: Vec<[f64; 3]> = self.verts.iter().map(|v| [v.pos.x, v.pos.y, v.pos.z]).collect();
-        let shape = mesh::mesh_shape(&pos, &live).unwrap();
-        let cw = live.iter().filter(|t| !self.counter_clockwise(**t)).count();
-        let away = live
-            .iter()
-            .filter(|t| !self.faces_outward(**t, t.map(|i| self.pos(i))))
-            .count();
-        let folded = format!("{cw} cw, {away} away");
-        if stage == "final" {
-            for t in live.iter().filter(|t| !self.folds(std::iter::once(**t)).none()).take(6) {
-                let v = t.map(|i| self.verts[i as usize]);
-                eprintln!(
-                    "  folded {t:?}: at {:?}, charts {:?}, coords {:?}, sizes {:?}, normals·n {:?}",
-                    self.centroid(*t),
-                    v.map(|v| v.point.chart.0),
-                    v.map(|v| v.point.coords),
-                    v.map(|v| v.size),
-                    {
-                        let p = v.map(|v| v.pos);
-                        let n = (p[1] - p[0]).cross(&(p[2] - p[0])).normalize();
-                        v.map(|v| n.dot(&v.normal))
-                    }
-                );
-            }
-        }
-        eprintln!(
-            "{stage:>9}: {} tris, folded {folded}, angles {:.1}-{:.1}, {:.2}% ok, {} >150, bend {:.1}",
-            live.len(),
-            shape.smallest_angle,
-            shape.largest_angle,
-            100.0 * shape.well_shaped(),
-            shape.above_150,
-            shape.largest_bend
-        );
-    }
-
     // ------------------------------------------------------------------ surface points
 
     /// The surface at `p`, moved to its deepest chart; `None` where the surface has no normal or
@@ -274,7 +238,8 @@ impl Remesher<'_> {
     fn vertex(&self, p: ChartPoint) -> Option<Vertex> {
         let atlas = self.surface.atlas();
         let located = atlas.locate(p).ok()?;
-        let point = *located.representations().iter().max_by(|a, b| {
+        let reps = located.representations().to_vec();
+        let point = *reps.iter().max_by(|a, b| {
             let ma = atlas.charts()[a.chart.index()].domain().margin(a.coords);
             let mb = atlas.charts()[b.chart.index()].domain().margin(b.coords);
             ma.total_cmp(&mb)
@@ -289,6 +254,7 @@ impl Remesher<'_> {
         let kappa = k1.abs().max(k2.abs());
         Some(Vertex {
             point,
+            reps,
             pos: jet.pos,
             du: jet.du,
             dv: jet.dv,
@@ -311,10 +277,6 @@ impl Remesher<'_> {
     /// margin) among the vertices' home charts that holds them all.
     fn common_chart<const N: usize>(&self, ids: [u32; N]) -> Option<(ChartId, [Complex64; N])> {
         let atlas = self.surface.atlas();
-        let located: Vec<_> = ids
-            .iter()
-            .map(|&i| atlas.locate_unchecked(self.verts[i as usize].point))
-            .collect();
         let mut best: Option<(f64, ChartId, [Complex64; N])> = None;
         for &i in &ids {
             let chart = self.verts[i as usize].point.chart;
@@ -322,8 +284,9 @@ impl Remesher<'_> {
             let mut coords = [Complex64::ZERO; N];
             let mut margin = f64::INFINITY;
             let mut all = true;
-            for (k, m) in located.iter().enumerate() {
-                match m.in_chart(chart) {
+            for (k, &j) in ids.iter().enumerate() {
+                let reps = &self.verts[j as usize].reps;
+                match reps.iter().find(|r| r.chart == chart).map(|r| r.coords) {
                     Some(w) => {
                         coords[k] = w;
                         margin = margin.min(domain.margin(w));
@@ -453,8 +416,7 @@ impl Remesher<'_> {
                 continue;
             }
             for k in 0..3 {
-                self.half_edges
-                    .insert((tri[k], tri[(k + 1) % 3]), t as u32);
+                self.half_edges.insert((tri[k], tri[(k + 1) % 3]), t as u32);
                 self.rings[tri[k] as usize].push(t as u32);
             }
         }
@@ -473,13 +435,16 @@ impl Remesher<'_> {
         }
     }
 
-    /// The edges (a < b) of the live triangles.
+    /// The edges (a < b) of the live triangles, sorted: the same input gives the same mesh.
     fn edges(&self) -> Vec<(u32, u32)> {
-        self.half_edges
+        let mut edges: Vec<(u32, u32)> = self
+            .half_edges
             .keys()
             .filter(|(a, b)| a < b)
             .copied()
-            .collect()
+            .collect();
+        edges.sort_unstable();
+        edges
     }
 
     /// Whether every triangle around these vertices is unchanged in this pass.
@@ -505,7 +470,12 @@ impl Remesher<'_> {
     fn edge_wings(&self, a: u32, b: u32) -> Option<(u32, u32, u32, u32)> {
         let t1 = *self.half_edges.get(&(a, b))?;
         let t2 = *self.half_edges.get(&(b, a))?;
-        Some((t1, third(self.tris[t1 as usize], a, b), t2, third(self.tris[t2 as usize], b, a)))
+        Some((
+            t1,
+            third(self.tris[t1 as usize], a, b),
+            t2,
+            third(self.tris[t2 as usize], b, a),
+        ))
     }
 
     /// The vertices adjacent to `v` (from its ring, which must be fresh).
@@ -556,7 +526,9 @@ impl Remesher<'_> {
                 Some((t1, _, t2, _)) => {
                     normal(t1).dot(&normal(t2)) < limit
                         && (self.pos(a) - self.pos(b)).norm() > 2.0 * self.min_edge
-                        && self.folds([t1, t2].map(|t| self.tris[t as usize]).into_iter()).none()
+                        && self
+                            .folds([t1, t2].map(|t| self.tris[t as usize]).into_iter())
+                            .none()
                 }
                 None => false,
             })
@@ -684,7 +656,9 @@ impl Remesher<'_> {
         }
         // Where nothing was folded, no edge may come out longer than a split would leave.
         let too_long = |i: u32| {
-            let limit = self.verts[i as usize].size.min(self.verts[kept as usize].size);
+            let limit = self.verts[i as usize]
+                .size
+                .min(self.verts[kept as usize].size);
             (self.pos(i) - kept_pos).norm() > 4.0 / 3.0 * limit
         };
         if old_folds.none() && changed.flatten().any(|i| i != kept && too_long(i)) {
@@ -787,7 +761,7 @@ impl Remesher<'_> {
     }
 
     fn relax(&mut self, v: u32) {
-        let vert = self.verts[v as usize];
+        let vert = &self.verts[v as usize];
         let (mut sum, mut weight) = (Vector3::zeros(), 0.0);
         for &t in &self.rings[v as usize] {
             let tri = self.tris[t as usize];
@@ -821,10 +795,8 @@ impl Remesher<'_> {
         let old_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
         let saved = std::mem::replace(&mut self.verts[v as usize], moved);
         let new_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
-        self.verts[v as usize] = saved;
-        let ok = new_folds.no_worse_than(old_folds);
-        if ok {
-            self.verts[v as usize] = moved;
+        if !new_folds.no_worse_than(old_folds) {
+            self.verts[v as usize] = saved;
         }
     }
 

@@ -121,7 +121,12 @@ mod tests {
     #[test]
     fn a_tetrahedron_has_sixty_degree_angles_and_its_dihedral_bend() {
         let s = 1.0 / 2f64.sqrt();
-        let p = [[1.0, 0.0, -s], [-1.0, 0.0, -s], [0.0, 1.0, s], [0.0, -1.0, s]];
+        let p = [
+            [1.0, 0.0, -s],
+            [-1.0, 0.0, -s],
+            [0.0, 1.0, s],
+            [0.0, -1.0, s],
+        ];
         let t = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
         let shape = mesh_shape(&p, &t).unwrap();
         assert!((shape.smallest_angle - 60.0).abs() < 1e-9);
@@ -129,14 +134,23 @@ mod tests {
         assert_eq!((shape.below_20, shape.above_150), (0, 0));
         // The regular tetrahedron's faces meet at acos(1/3); their normals at 180° minus that.
         let bend = 180.0 - (1.0f64 / 3.0).acos().to_degrees();
-        assert!((shape.largest_bend - bend).abs() < 1e-9, "{}", shape.largest_bend);
+        assert!(
+            (shape.largest_bend - bend).abs() < 1e-9,
+            "{}",
+            shape.largest_bend
+        );
         assert_eq!(shape.well_shaped(), 1.0);
     }
 
     #[test]
     fn a_sliver_and_a_flat_pair_are_counted() {
         // Two triangles in the plane z = 0 sharing edge 0–1: one fine, one a 170° sliver.
-        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.8, 0.0], [0.5, -0.04, 0.0]];
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, 0.8, 0.0],
+            [0.5, -0.04, 0.0],
+        ];
         let t = [[0, 1, 2], [1, 0, 3]];
         let shape = mesh_shape(&p, &t).unwrap();
         assert_eq!((shape.below_20, shape.above_150), (1, 1));

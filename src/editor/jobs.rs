@@ -122,7 +122,8 @@ impl Jobs {
         self.spawn("exporting".into(), move || {
             let format = Format::from_path(&path)?;
             let options = export::ExportOptions::default();
-            let exported = export::export_surface(&surface, (te, tr), &path, format, &options)?;
+            let exported =
+                export::export_surface(&surface, (te, tr).into(), &path, format, &options)?;
             Ok(JobOutput::Exported { exported, path })
         });
     }

@@ -527,3 +527,66 @@ fn t_e_1_is_fine_at_genus_0() {
     assert!(topology.closed && topology.manifold);
     assert_eq!(topology.euler_characteristic, 2);
 }
+
+/// `--tolerance` exports the quality tessellation: the summary says so, the file is a closed mesh
+/// of well-shaped triangles; a tolerance out of range, or with --te, is refused before any work.
+#[test]
+fn tolerance_exports_the_quality_tessellation() {
+    let (dir, model) = workspace();
+    let out = dir.path().join("q.obj");
+    let run = ntori()
+        .arg("export")
+        .arg(&model)
+        .arg("-o")
+        .arg(&out)
+        .args(["--tolerance", "0.002"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains(
+            "quality tessellation to 0.002 of the diagonal",
+        ))
+        .stderr(predicate::str::is_empty());
+    drop(run);
+    let (models, _) = tobj::load_obj(&out, &tobj::GPU_LOAD_OPTIONS).unwrap();
+    let m = &models[0].mesh;
+    let positions: Vec<[f64; 3]> = m
+        .positions
+        .chunks(3)
+        .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+        .collect();
+    let triangles: Vec<[u32; 3]> = m.indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let topology =
+        mesh::HalfEdgeMesh::from_polygons(positions.len(), triangles.iter().map(|t| &t[..]))
+            .unwrap()
+            .topology();
+    assert!(topology.closed && topology.manifold);
+    assert_eq!(topology.euler_characteristic, -2);
+    let shape = mesh::mesh_shape(&positions, &triangles).unwrap();
+    assert!(shape.well_shaped() >= 0.99, "{shape:?}");
+    assert!(shape.largest_bend <= 20.0, "{shape:?}");
+    for (bad, says) in [
+        (
+            &["--tolerance", "0.5"][..],
+            "the tolerance is a fraction of the diagonal",
+        ),
+        (
+            &["--tolerance", "nan"][..],
+            "the tolerance is a fraction of the diagonal",
+        ),
+        (
+            &["--tolerance", "0.001", "--te", "8"][..],
+            "cannot be used with",
+        ),
+    ] {
+        ntori()
+            .arg("export")
+            .arg(&model)
+            .arg("-o")
+            .arg(dir.path().join("bad.obj"))
+            .args(bad)
+            .assert()
+            .failure()
+            .stderr(predicate::str::contains(says));
+    }
+    assert!(!dir.path().join("bad.obj").exists());
+}

@@ -651,7 +651,7 @@ fn export_surface_writes_what_surface_mesh_makes_and_says_so() {
         let path = dir.path().join(format!("g{genus}-{te}-{tr}.off"));
         let options = ExportOptions::default();
         let exported =
-            export::export_surface(surface, (te, tr), &path, Format::Off, &options).unwrap();
+            export::export_surface(surface, (te, tr).into(), &path, Format::Off, &options).unwrap();
         let mesh = surface_mesh(surface, (te, tr), UvLayout::Chart).unwrap();
         assert_eq!(exported.vertices, mesh.positions.len());
         assert_eq!(exported.triangles, mesh.triangles.len());

@@ -29,6 +29,7 @@
 use std::path::{Path, PathBuf};
 
 use charts::{ChartId, ChartPoint, Tessellation};
+use embedding::remesh::{QualitySettings, quality_mesh};
 use embedding::{EmbeddingError, Point3, Sample, Surface, Vector3, Wants, evaluate};
 use num_complex::Complex64;
 
@@ -61,10 +62,13 @@ pub const MAX_ROUNDING: f64 = 1e-5;
 pub const MAX_TRIANGLES: u64 = 20_000_000;
 
 /// What a [`SurfaceMesh`] was made from, for file headers.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum MeshSource {
     /// The t_e/t_r tessellation ([`surface_mesh`]).
     Tessellation { te: u32, tr: u32 },
+    /// The quality tessellation ([`quality_surface_mesh`]) at this chordal tolerance, a fraction
+    /// of the surface's diagonal.
+    Quality { tolerance: f64 },
     /// The mesh a fit targets ([`input_mesh`]).
     FitInput,
     /// Another mesh of chart points ([`evaluate_mesh`]).
@@ -309,6 +313,70 @@ pub fn surface_mesh(
     Ok(mesh)
 }
 
+/// How an export tessellates the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Meshing {
+    /// The paper's t_e/t_r scheme ([`surface_mesh`]).
+    TeTr { te: u32, tr: u32 },
+    /// The quality tessellation ([`quality_surface_mesh`]) to this chordal tolerance, a fraction
+    /// of the surface's diagonal.
+    Quality { tolerance: f64 },
+}
+
+impl From<(u32, u32)> for Meshing {
+    fn from((te, tr): (u32, u32)) -> Meshing {
+        Meshing::TeTr { te, tr }
+    }
+}
+
+impl std::fmt::Display for Meshing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Meshing::TeTr { te, tr } => write!(f, "t_e = {te}, t_r = {tr}"),
+            Meshing::Quality { tolerance } => {
+                write!(f, "quality tessellation to {tolerance} of the diagonal")
+            }
+        }
+    }
+}
+
+/// Tessellates the surface with `meshing` and evaluates it, texture coordinates laid out as `uv`
+/// says.
+pub fn mesh_surface(
+    surface: &Surface,
+    meshing: Meshing,
+    uv: UvLayout,
+) -> Result<SurfaceMesh, ExportError> {
+    match meshing {
+        Meshing::TeTr { te, tr } => surface_mesh(surface, (te, tr), uv),
+        Meshing::Quality { tolerance } => quality_surface_mesh(surface, tolerance, uv),
+    }
+}
+
+/// The quality tessellation of the surface (`embedding::remesh`: well-shaped triangles sized by
+/// the curvature, chordal error within `tolerance` of the diagonal), evaluated ([`evaluate_mesh`]).
+pub fn quality_surface_mesh(
+    surface: &Surface,
+    tolerance: f64,
+    uv: UvLayout,
+) -> Result<SurfaceMesh, ExportError> {
+    check_not_degenerate(surface, 0)?;
+    let settings = QualitySettings {
+        tolerance,
+        ..QualitySettings::default()
+    };
+    let q = quality_mesh(surface, &settings)?;
+    let input = ChartMesh {
+        vertices: &q.vertices,
+        triangles: &q.triangles,
+        triangle_charts: &q.triangle_charts,
+        triangle_coords: &q.triangle_coords,
+    };
+    let mut mesh = evaluate_mesh(surface, input, uv)?;
+    mesh.source = MeshSource::Quality { tolerance };
+    Ok(mesh)
+}
+
 /// A surface whose control points coincide has no surface to export: refused, naming how many
 /// vertices would have no normal.
 fn check_not_degenerate(surface: &Surface, vertices: u64) -> Result<(), ExportError> {
@@ -494,6 +562,10 @@ impl SurfaceMesh {
             MeshSource::Tessellation { te, tr } => {
                 format!("genus {}, t_e = {te}, t_r = {tr}", self.genus)
             }
+            MeshSource::Quality { tolerance } => format!(
+                "genus {}, quality tessellation to {tolerance} of the diagonal",
+                self.genus
+            ),
             MeshSource::FitInput => format!("the input mesh of a genus-{} fit", self.genus),
             MeshSource::ChartMesh => format!("genus {}", self.genus),
         };
@@ -640,17 +712,17 @@ pub struct Exported {
     pub unit: Units,
 }
 
-/// The export behind `ntori export` and the editor's: tessellates and evaluates `surface` at
-/// t_e, t_r ([`surface_mesh`]) and writes it to `path` ([`write()`]).
+/// The export behind `ntori export` and the editor's: tessellates and evaluates `surface` as
+/// `meshing` says ([`mesh_surface`]) and writes it to `path` ([`write()`]).
 pub fn export_surface(
     surface: &Surface,
-    (te, tr): (u32, u32),
+    meshing: Meshing,
     path: &Path,
     format: Format,
     options: &ExportOptions,
 ) -> Result<Exported, ExportError> {
     options.check(format)?;
-    let mut mesh = surface_mesh(surface, (te, tr), options.uv)?;
+    let mut mesh = mesh_surface(surface, meshing, options.uv)?;
     let info = FileInfo::new(&mesh, format, options);
     // Placed where it lies (no copy: an export may hold 10⁷ vertices).
     mesh.place(options.up_for(format), options.factor_for(format));
