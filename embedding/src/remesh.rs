@@ -247,7 +247,7 @@ impl Remesher<'_> {
         let jet = self.surface.eval(point);
         let cross = jet.du.cross(&jet.dv);
         let area = cross.norm();
-        if !(area > 1e-12 * self.max_edge * self.max_edge) {
+        if area.is_nan() || area <= 1e-12 * self.max_edge * self.max_edge {
             return None;
         }
         let (k1, k2) = jet.principal_curvatures();
@@ -343,7 +343,7 @@ impl Remesher<'_> {
     fn faces_outward(&self, t: [u32; 3], pos: [Point3; 3]) -> bool {
         let n = (pos[1] - pos[0]).cross(&(pos[2] - pos[0]));
         let len = n.norm();
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             return false;
         }
         t.iter()
@@ -770,7 +770,7 @@ impl Remesher<'_> {
             sum += self.centroid(tri).coords * area;
             weight += area;
         }
-        if !(weight > 0.0) {
+        if weight.is_nan() || weight <= 0.0 {
             return;
         }
         let step = (sum / weight - vert.pos.coords) * 0.6;
@@ -782,7 +782,7 @@ impl Remesher<'_> {
             vert.dv.dot(&vert.dv),
         );
         let det = e * g - f * f;
-        if !(det > 0.0) {
+        if det.is_nan() || det <= 0.0 {
             return;
         }
         let (ru, rv) = (vert.du.dot(&step), vert.dv.dot(&step));
