@@ -37,6 +37,9 @@ use crate::{EmbeddingError, Point3, Surface, Vector3};
 /// How fast the target edge length may grow from one vertex to its neighbour, per unit distance.
 pub const GRADATION: f64 = 0.35;
 
+/// The t_e = t_r of the tessellation the remesher starts from.
+pub const START_RESOLUTION: u32 = 8;
+
 /// The largest angle (degrees) between neighbouring triangles' normals the remesher leaves: edges
 /// bending more are split.
 pub const MAX_BEND: f64 = 18.0;
@@ -144,7 +147,9 @@ pub fn quality_mesh(
 ) -> Result<QualityMesh, EmbeddingError> {
     settings.check()?;
     // A coarse start with the right topology; its slivers are remeshed away.
-    let start = surface.atlas().tessellate(8, 8)?;
+    let start = surface
+        .atlas()
+        .tessellate(START_RESOLUTION, START_RESOLUTION)?;
     // The surface's own size (its control net can reach far beyond it).
     let positions: Vec<Point3> = start
         .vertices
@@ -815,11 +820,10 @@ impl Remesher<'_> {
                 }
             }
             let (chart, coords) = self.common_chart(*t).ok_or_else(|| {
+                let c = self.centroid(*t);
                 EmbeddingError::Parameterization(format!(
                     "no chart holds all three corners of a triangle near ({:.3}, {:.3}, {:.3})",
-                    self.centroid(*t).x,
-                    self.centroid(*t).y,
-                    self.centroid(*t).z
+                    c.x, c.y, c.z
                 ))
             })?;
             mesh.triangles.push(t.map(|i| remap[i as usize]));

@@ -365,23 +365,26 @@ fn assert_close(got: [f64; 3], want: [f64; 3], what: &str) {
     }
 }
 
+/// `ntori export MODEL -o OUT` at t_e = t_r = 6 with `extra` options; what it printed.
+fn coarse_export(model: &Path, out: &Path, extra: &[&str]) -> String {
+    let assert = ntori()
+        .arg("export")
+        .arg(model)
+        .args(["--te", "6", "--tr", "6", "-o"])
+        .arg(out)
+        .args(extra)
+        .assert()
+        .success();
+    String::from_utf8_lossy(&assert.get_output().stdout).into_owned()
+}
+
 #[test]
 fn up_scale_and_units_reach_the_file() {
     let (dir, model) = workspace();
     let export = |name: &str, extra: &[&str]| -> (PathBuf, String) {
         let out = dir.path().join(name);
-        let assert = ntori()
-            .arg("export")
-            .arg(&model)
-            .args(["--te", "6", "--tr", "6", "-o"])
-            .arg(&out)
-            .args(extra)
-            .assert()
-            .success();
-        (
-            out,
-            String::from_utf8_lossy(&assert.get_output().stdout).into_owned(),
-        )
+        let said = coarse_export(&model, &out, extra);
+        (out, said)
     };
     // OFF: z up, no unit, so the model's own coordinates (a model unit is 1 cm by default).
     let (off, said) = export("model.off", &[]);
@@ -474,16 +477,7 @@ fn up_scale_and_units_reach_the_file() {
 fn the_uv_atlas_splits_the_mesh_at_chart_seams() {
     let (dir, model) = workspace();
     let vertices = |extra: &[&str]| -> usize {
-        let out = dir.path().join("m.ply");
-        let assert = ntori()
-            .arg("export")
-            .arg(&model)
-            .args(["--te", "6", "--tr", "6", "-o"])
-            .arg(&out)
-            .args(extra)
-            .assert()
-            .success();
-        let said = String::from_utf8_lossy(&assert.get_output().stdout).into_owned();
+        let said = coarse_export(&model, &dir.path().join("m.ply"), extra);
         let words: Vec<&str> = said.split_whitespace().collect();
         let at = words.iter().position(|w| *w == "vertices,").unwrap();
         words[at - 1].parse().unwrap()

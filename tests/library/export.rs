@@ -566,6 +566,14 @@ fn bad_resolutions_and_degenerate_surfaces_are_refused() {
     let point = Surface::from_model(&point).unwrap();
     let err = surface_mesh(&point, (4, 4), UvLayout::Chart).unwrap_err();
     assert!(matches!(err, ExportError::Degenerate { .. }), "{err}");
+    // The quality tessellation refuses it too, counting the vertices it would start from.
+    let err = export::quality_surface_mesh(&point, 1e-3, UvLayout::Chart).unwrap_err();
+    let start = embedding::remesh::START_RESOLUTION;
+    let expected = charts::Tessellation::expected_vertices(point.genus(), start, start) as usize;
+    assert!(
+        matches!(err, ExportError::Degenerate { count, .. } if count == expected),
+        "{err}"
+    );
 }
 
 #[test]

@@ -29,7 +29,7 @@
 use std::path::{Path, PathBuf};
 
 use charts::{ChartId, ChartPoint, Tessellation};
-use embedding::remesh::{QualitySettings, quality_mesh};
+use embedding::remesh::{self, QualitySettings, quality_mesh};
 use embedding::{EmbeddingError, Point3, Sample, Surface, Vector3, Wants, evaluate};
 use num_complex::Complex64;
 
@@ -360,7 +360,12 @@ pub fn quality_surface_mesh(
     tolerance: f64,
     uv: UvLayout,
 ) -> Result<SurfaceMesh, ExportError> {
-    check_not_degenerate(surface, 0)?;
+    // Refused before remeshing, counting the vertices the remesher would start from.
+    let start = remesh::START_RESOLUTION;
+    check_not_degenerate(
+        surface,
+        Tessellation::expected_vertices(surface.genus(), start, start),
+    )?;
     let settings = QualitySettings {
         tolerance,
         ..QualitySettings::default()
