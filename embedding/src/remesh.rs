@@ -5,7 +5,8 @@
 //! module remeshes on the surface itself, the isotropic remeshing of Botsch and Kobbelt (2004) with
 //! a curvature-adaptive target edge length:
 //!
-//! 1. start from a coarse t_e/t_r tessellation (a valid closed mesh of the right topology);
+//! 1. start from the squares of a coarse t_e/t_r tessellation, its wheels retriangulated (see
+//!    `remesh/start.rs`): a closed mesh of the right topology;
 //! 2. repeat: split edges longer than 4/3 of the target length, collapse edges shorter than 4/5 of
 //!    it, flip edges towards valence 6, and move every vertex towards the area-weighted centre of
 //!    its triangles, within the tangent plane;
@@ -27,17 +28,19 @@
 //! The topology never changes: every operation keeps the mesh closed, manifold and oriented, so
 //! χ = 2 − 2n holds exactly (tested).
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 use charts::{ChartId, ChartPoint};
 use num_complex::Complex64;
 
 use crate::{EmbeddingError, Point3, Surface, Vector3};
 
+mod start;
+
 /// How fast the target edge length may grow from one vertex to its neighbour, per unit distance.
 pub const GRADATION: f64 = 0.35;
 
-/// The t_e = t_r of the tessellation the remesher starts from.
+/// The t_e of the tessellation whose squares the remesher starts from.
 pub const START_RESOLUTION: u32 = 8;
 
 /// The largest angle (degrees) between neighbouring triangles' normals the remesher leaves: edges
@@ -120,7 +123,8 @@ struct Vertex {
 
 const DEAD: u32 = u32::MAX;
 
-/// The remesher's state: vertices, triangles, and per pass the adjacency it rebuilds.
+/// The remesher's state: vertices, triangles and the triangles around each vertex, which every
+/// operation keeps up to date.
 struct Remesher<'a> {
     surface: &'a Surface,
     /// Absolute tolerance and edge-length bounds.
@@ -130,12 +134,8 @@ struct Remesher<'a> {
     min_edge: f64,
     verts: Vec<Vertex>,
     tris: Vec<[u32; 3]>,
-    /// Directed edge (a, b) → the triangle holding it; rebuilt every pass.
-    half_edges: HashMap<(u32, u32), u32>,
-    /// Triangles around each vertex; rebuilt every pass.
+    /// The live triangles around each vertex (none around a collapsed one).
     rings: Vec<Vec<u32>>,
-    /// Triangles an operation of this pass changed: the adjacency is stale around them.
-    locked: Vec<bool>,
     /// Triangles (by corners) whose chordal error is known to be within the tolerance.
     chordal_fine: HashSet<[u32; 3]>,
 }
@@ -147,9 +147,7 @@ pub fn quality_mesh(
 ) -> Result<QualityMesh, EmbeddingError> {
     settings.check()?;
     // A coarse start with the right topology; its slivers are remeshed away.
-    let start = surface
-        .atlas()
-        .tessellate(START_RESOLUTION, START_RESOLUTION)?;
+    let start = start::start_mesh(surface.atlas(), START_RESOLUTION)?;
     // The surface's own size (its control net can reach far beyond it).
     let positions: Vec<Point3> = start
         .vertices
@@ -165,16 +163,15 @@ pub fn quality_mesh(
         min_edge: 5e-4 * diagonal,
         verts: Vec::with_capacity(start.vertices.len()),
         tris: start.triangles,
-        half_edges: HashMap::new(),
         rings: Vec::new(),
-        locked: Vec::new(),
         chordal_fine: HashSet::new(),
     };
     for &p in &start.vertices {
         let v = r.vertex(p).ok_or_else(|| pinched(p))?;
         r.verts.push(v);
     }
-    // The t_e/t_r triangles wind counter-clockwise in their charts, which is outward.
+    r.build_rings();
+    // The start's triangles wind counter-clockwise in their charts, which is outward.
     // Clean the start's slivers before refining: splitting a sliver makes more of them.
     r.repeat(|r| r.collapse_short());
     r.repeat(|r| r.flip(FlipRule::Valence));
@@ -309,6 +306,21 @@ impl Remesher<'_> {
         best.map(|(_, c, w)| (c, w))
     }
 
+    /// Coordinates of the given vertices in the first of their home charts that holds them all:
+    /// cheaper than [`Self::common_chart`] where any chart will do (orientation tests: the
+    /// transitions preserve it).
+    fn shared_chart<const N: usize>(&self, ids: [u32; N]) -> Option<[Complex64; N]> {
+        ids.iter().find_map(|&i| {
+            let chart = self.verts[i as usize].point.chart;
+            let mut coords = [Complex64::ZERO; N];
+            for (k, &j) in ids.iter().enumerate() {
+                let reps = &self.verts[j as usize].reps;
+                coords[k] = reps.iter().find(|r| r.chart == chart)?.coords;
+            }
+            Some(coords)
+        })
+    }
+
     /// The surface point at the mean chart coordinates of `ids`.
     fn centre<const N: usize>(&self, ids: [u32; N]) -> Option<Vertex> {
         let (chart, coords) = self.common_chart(ids)?;
@@ -372,8 +384,8 @@ impl Remesher<'_> {
     /// Whether the triangle winds counter-clockwise in a chart holding all three corners, as the
     /// start mesh's do: the surface is oriented, so a turned-over triangle winds the other way.
     fn counter_clockwise(&self, t: [u32; 3]) -> bool {
-        match self.common_chart(t) {
-            Some((_, [a, b, c])) => {
+        match self.shared_chart(t) {
+            Some([a, b, c]) => {
                 let (u, v) = (b - a, c - a);
                 u.re * v.im - u.im * v.re > 0.0
             }
@@ -411,70 +423,78 @@ impl Remesher<'_> {
 
     // ------------------------------------------------------------------ connectivity
 
-    /// Rebuilds the adjacency and clears the locks.
-    fn rebuild(&mut self) {
-        self.half_edges.clear();
-        self.rings.clear();
-        self.rings.resize(self.verts.len(), Vec::new());
+    /// Builds the rings from the triangles (the operations then keep them up to date).
+    fn build_rings(&mut self) {
+        self.rings = vec![Vec::new(); self.verts.len()];
         for (t, tri) in self.tris.iter().enumerate() {
-            if tri[0] == DEAD {
-                continue;
-            }
-            for k in 0..3 {
-                self.half_edges.insert((tri[k], tri[(k + 1) % 3]), t as u32);
-                self.rings[tri[k] as usize].push(t as u32);
+            if tri[0] != DEAD {
+                for &v in tri {
+                    self.rings[v as usize].push(t as u32);
+                }
             }
         }
-        self.locked.clear();
-        self.locked.resize(self.tris.len(), false);
+    }
+
+    /// Replaces `from` by `to` in `v`'s ring.
+    fn ring_replace(&mut self, v: u32, from: u32, to: u32) {
+        if let Some(slot) = self.rings[v as usize].iter_mut().find(|t| **t == from) {
+            *slot = to;
+        }
+    }
+
+    fn ring_remove(&mut self, v: u32, t: u32) {
+        self.rings[v as usize].retain(|&x| x != t);
     }
 
     /// Runs passes of `pass` (which returns how many operations it made) until one makes none,
     /// at most [`MAX_PASSES`].
     fn repeat(&mut self, mut pass: impl FnMut(&mut Self) -> usize) {
+        let mut log = Vec::new();
         for _ in 0..MAX_PASSES {
-            self.rebuild();
-            if pass(self) == 0 {
+            let n = pass(self);
+            log.push(n);
+            if n == 0 {
                 break;
             }
         }
-    }
-
-    /// The edges (a < b) of the live triangles, sorted: the same input gives the same mesh.
-    fn edges(&self) -> Vec<(u32, u32)> {
-        let mut edges: Vec<(u32, u32)> = self
-            .half_edges
-            .keys()
-            .filter(|(a, b)| a < b)
-            .copied()
-            .collect();
-        edges.sort_unstable();
-        edges
-    }
-
-    /// Whether every triangle around these vertices is unchanged in this pass.
-    fn rings_fresh(&self, vertices: &[u32]) -> bool {
-        vertices.iter().all(|&v| {
-            self.rings[v as usize]
-                .iter()
-                .all(|&t| !self.locked[t as usize])
-        })
-    }
-
-    fn lock_rings(&mut self, vertices: &[u32]) {
-        for &v in vertices {
-            for k in 0..self.rings[v as usize].len() {
-                let t = self.rings[v as usize][k];
-                self.locked[t as usize] = true;
-            }
+        if std::env::var("NTORI_REMESH_LOG").is_ok() {
+            eprintln!("{log:?}");
         }
     }
 
+    /// The edges (a < b) of the live triangles, each once (a closed manifold mesh holds a→b in
+    /// one triangle and b→a in another), in triangle order: the same input gives the same mesh.
+    fn edges(&self) -> Vec<(u32, u32)> {
+        let mut edges = Vec::with_capacity(self.tris.len() * 3 / 2);
+        for tri in self.tris.iter().filter(|t| t[0] != DEAD) {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if a < b {
+                    edges.push((a, b));
+                }
+            }
+        }
+        edges
+    }
+
+    /// The live triangles around `v`.
+    fn ring(&self, v: u32) -> &[u32] {
+        &self.rings[v as usize]
+    }
+
+    /// The triangle around `a` (by its ring) holding the directed edge a→b.
+    fn triangle_with(&self, a: u32, b: u32) -> Option<u32> {
+        self.ring(a).iter().copied().find(|&t| {
+            let tri = self.tris[t as usize];
+            (0..3).any(|k| tri[k] == a && tri[(k + 1) % 3] == b)
+        })
+    }
+
     /// The triangles on each side of edge a→b and their third corners: (t₁ = (a, b, c), c) and
-    /// (t₂ = (b, a, d), d).
+    /// (t₂ = (b, a, d), d); `None` if the edge no longer exists.
     fn edge_wings(&self, a: u32, b: u32) -> Option<(u32, u32, u32, u32)> {
-        let t1 = *self.half_edges.get(&(a, b))?;
-        let t2 = *self.half_edges.get(&(b, a))?;
+        let t1 = self.triangle_with(a, b)?;
+        let t2 = self.triangle_with(b, a)?;
         Some((
             t1,
             third(self.tris[t1 as usize], a, b),
@@ -485,7 +505,8 @@ impl Remesher<'_> {
 
     /// The vertices adjacent to `v` (from its ring, which must be fresh).
     fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut n: Vec<u32> = self.rings[v as usize]
+        let mut n: Vec<u32> = self
+            .ring(v)
             .iter()
             .flat_map(|&t| self.tris[t as usize])
             .filter(|&u| u != v)
@@ -496,7 +517,7 @@ impl Remesher<'_> {
     }
 
     fn valence(&self, v: u32) -> usize {
-        self.rings[v as usize].len()
+        self.ring(v).len()
     }
 
     // ------------------------------------------------------------------ operations
@@ -592,9 +613,6 @@ impl Remesher<'_> {
         let Some((t1, c, t2, d)) = self.edge_wings(a, b) else {
             return false;
         };
-        if self.locked[t1 as usize] || self.locked[t2 as usize] {
-            return false;
-        }
         let Some(mid) = self.centre([a, b]) else {
             return false;
         };
@@ -606,13 +624,18 @@ impl Remesher<'_> {
             self.verts.pop();
             return false;
         }
+        self.rings.push(Vec::new());
+        let (t3, t4) = (self.tris.len() as u32, self.tris.len() as u32 + 1);
         self.tris[t1 as usize] = [a, m, c];
         self.tris[t2 as usize] = [b, m, d];
         self.tris.push([m, b, c]);
         self.tris.push([m, a, d]);
-        self.locked[t1 as usize] = true;
-        self.locked[t2 as usize] = true;
-        self.locked.extend([true, true]);
+        // a leaves t₂ for t₄, b leaves t₁ for t₃; c gains t₃, d gains t₄.
+        self.ring_replace(a, t2, t4);
+        self.ring_replace(b, t1, t3);
+        self.rings[c as usize].push(t3);
+        self.rings[d as usize].push(t4);
+        self.rings[m as usize] = vec![t1, t3, t2, t4];
         true
     }
 
@@ -637,20 +660,20 @@ impl Remesher<'_> {
         let Some((t1, c, t2, d)) = self.edge_wings(kept, gone) else {
             return false;
         };
-        if !self.rings_fresh(&[gone, kept]) {
+        if self.valence(c) <= 3
+            || self.valence(d) <= 3
+            || self.valence(gone) + self.valence(kept) - 4 > 10
+        {
             return false;
         }
         // The link condition: the ends share exactly the two wing vertices.
         let (ng, nk) = (self.neighbours(gone), self.neighbours(kept));
         let shared = ng.iter().filter(|v| nk.binary_search(v).is_ok()).count();
-        if shared != 2 || self.valence(c) <= 3 || self.valence(d) <= 3 {
-            return false;
-        }
-        if self.valence(gone) + self.valence(kept) - 4 > 10 {
+        if shared != 2 {
             return false;
         }
         let kept_pos = self.pos(kept);
-        let ring = &self.rings[gone as usize];
+        let ring = self.ring(gone);
         let old_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
         let changed = ring
             .iter()
@@ -669,18 +692,22 @@ impl Remesher<'_> {
         if old_folds.none() && changed.flatten().any(|i| i != kept && too_long(i)) {
             return false;
         }
-        self.lock_rings(&[gone, kept]);
-        for k in 0..self.rings[gone as usize].len() {
-            let t = self.rings[gone as usize][k] as usize;
-            if t as u32 == t1 || t as u32 == t2 {
-                self.tris[t] = [DEAD; 3];
+        // The wings die; gone's other triangles pass to kept (by the link condition none held
+        // kept before).
+        for t in std::mem::take(&mut self.rings[gone as usize]) {
+            if t == t1 || t == t2 {
+                self.tris[t as usize] = [DEAD; 3];
             } else {
-                for i in self.tris[t].iter_mut() {
+                for i in self.tris[t as usize].iter_mut() {
                     if *i == gone {
                         *i = kept;
                     }
                 }
+                self.rings[kept as usize].push(t);
             }
+        }
+        for (v, t) in [(kept, t1), (kept, t2), (c, t1), (d, t2)] {
+            self.ring_remove(v, t);
         }
         true
     }
@@ -700,7 +727,7 @@ impl Remesher<'_> {
         let Some((t1, c, t2, d)) = self.edge_wings(a, b) else {
             return false;
         };
-        if !self.rings_fresh(&[a, b, c, d]) || self.half_edges.contains_key(&(c, d)) {
+        if self.triangle_with(c, d).is_some() {
             return false;
         }
         if self.valence(a) <= 3 || self.valence(b) <= 3 {
@@ -746,19 +773,22 @@ impl Remesher<'_> {
         {
             return false;
         }
-        self.lock_rings(&[a, b, c, d]);
         self.tris[t1 as usize] = n1;
         self.tris[t2 as usize] = n2;
+        // t₁ = (a, d, c) and t₂ = (d, b, c): a leaves t₂, b leaves t₁, c joins t₂, d joins t₁.
+        self.ring_remove(a, t2);
+        self.ring_remove(b, t1);
+        self.rings[c as usize].push(t2);
+        self.rings[d as usize].push(t1);
         true
     }
 
     /// Gauss–Seidel sweeps moving each vertex part way towards the area-weighted centre of its
     /// triangles, within its tangent plane, where no triangle around it turns over.
     fn smooth(&mut self, sweeps: usize) {
-        self.rebuild();
         for _ in 0..sweeps {
             for v in 0..self.verts.len() as u32 {
-                if !self.rings[v as usize].is_empty() {
+                if !self.ring(v).is_empty() {
                     self.relax(v);
                 }
             }
@@ -768,7 +798,7 @@ impl Remesher<'_> {
     fn relax(&mut self, v: u32) {
         let vert = &self.verts[v as usize];
         let (mut sum, mut weight) = (Vector3::zeros(), 0.0);
-        for &t in &self.rings[v as usize] {
+        for &t in self.ring(v) {
             let tri = self.tris[t as usize];
             let p = tri.map(|i| self.pos(i));
             let area = 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
@@ -796,10 +826,10 @@ impl Remesher<'_> {
         else {
             return;
         };
-        let ring = &self.rings[v as usize];
-        let old_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
+        let around = |r: &Self| r.folds(r.ring(v).iter().map(|&t| r.tris[t as usize]));
+        let old_folds = around(self);
         let saved = std::mem::replace(&mut self.verts[v as usize], moved);
-        let new_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
+        let new_folds = around(self);
         if !new_folds.no_worse_than(old_folds) {
             self.verts[v as usize] = saved;
         }

@@ -1,0 +1,77 @@
+//! Issue 15's quality tessellation over the example models: triangle count and time against the
+//! t_e = t_r = 32 tessellation, triangle angles, the largest bend between neighbours, triangles
+//! facing away from the surface, and the chordal error.
+//! `cargo run --release -p embedding --example quality_report [GENERA…]`
+use std::time::Instant;
+
+use embedding::remesh::{QualitySettings, quality_mesh};
+use embedding::{Model, Point3, Stencil, Surface};
+
+fn asset(genus: u32) -> Option<Surface> {
+    let path = format!(
+        "{}/../assets/models/genus-{genus}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(path).ok()?;
+    let model: Model = serde_json::from_str(&text).expect("a model");
+    Some(Surface::from_model(&model).expect("a surface"))
+}
+
+fn main() {
+    let genera: Vec<u32> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("a genus"))
+        .collect();
+    let genera = if genera.is_empty() {
+        (0..=10).collect()
+    } else {
+        genera
+    };
+    let settings = QualitySettings::default();
+    println!(
+        "genus  triangles  time(s)  t32-triangles  t32-time(s)  angles(°)      ≥20°(%)  ≥150°  bend(°)  away  chordal/diag"
+    );
+    for genus in genera {
+        let Some(s) = asset(genus) else { continue };
+        let start = Instant::now();
+        let q = quality_mesh(&s, &settings).expect("a quality mesh");
+        let seconds = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let tess = s.atlas().tessellate(32, 32).expect("a tessellation");
+        let stencil = Stencil::build(&s.layout(), &tess.vertices);
+        let mut positions = vec![Point3::origin(); stencil.rows()];
+        stencil.positions(s.control_points(), &mut positions);
+        let t32 = start.elapsed().as_secs_f64();
+        let pos: Vec<[f64; 3]> = q.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
+        let topology = mesh::HalfEdgeMesh::from_polygons(pos.len(), q.triangles.iter().map(|t| &t[..]))
+            .expect("a mesh")
+            .topology();
+        assert!(topology.closed && topology.manifold && topology.orientable, "genus {genus}");
+        assert_eq!(topology.euler_characteristic, 2 - 2 * genus as i64, "genus {genus}");
+        let shape = mesh::mesh_shape(&pos, &q.triangles).expect("a mesh");
+        let diagonal = embedding::fit::diagonal(&q.positions);
+        let (mut worst, mut away) = (0.0f64, 0);
+        for (t, tri) in q.triangles.iter().enumerate() {
+            let mean = q.triangle_coords[t].iter().sum::<num_complex::Complex64>() / 3.0;
+            let exact = s.eval(charts::ChartPoint::new(q.triangle_charts[t], mean));
+            let [a, b, c] = tri.map(|i| q.positions[i as usize]);
+            worst = worst.max(
+                (exact.pos - Point3::from((a.coords + b.coords + c.coords) / 3.0)).norm()
+                    / diagonal,
+            );
+            if (b - a).cross(&(c - a)).dot(&exact.normal()) <= 0.0 {
+                away += 1;
+            }
+        }
+        println!(
+            "{genus:5}  {:9}  {seconds:7.2}  {:13}  {t32:11.2}  {:5.1}–{:5.1}  {:7.2}  {:5}  {:7.1}  {away:4}  {worst:.2e}",
+            q.triangles.len(),
+            tess.triangles.len(),
+            shape.smallest_angle,
+            shape.largest_angle,
+            100.0 * shape.well_shaped(),
+            shape.above_150,
+            shape.largest_bend,
+        );
+    }
+}
