@@ -43,11 +43,19 @@ fn main() {
         stencil.positions(s.control_points(), &mut positions);
         let t32 = start.elapsed().as_secs_f64();
         let pos: Vec<[f64; 3]> = q.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
-        let topology = mesh::HalfEdgeMesh::from_polygons(pos.len(), q.triangles.iter().map(|t| &t[..]))
-            .expect("a mesh")
-            .topology();
-        assert!(topology.closed && topology.manifold && topology.orientable, "genus {genus}");
-        assert_eq!(topology.euler_characteristic, 2 - 2 * genus as i64, "genus {genus}");
+        let topology =
+            mesh::HalfEdgeMesh::from_polygons(pos.len(), q.triangles.iter().map(|t| &t[..]))
+                .expect("a mesh")
+                .topology();
+        assert!(
+            topology.closed && topology.manifold && topology.orientable,
+            "genus {genus}"
+        );
+        assert_eq!(
+            topology.euler_characteristic,
+            2 - 2 * genus as i64,
+            "genus {genus}"
+        );
         let shape = mesh::mesh_shape(&pos, &q.triangles).expect("a mesh");
         let diagonal = embedding::fit::diagonal(&q.positions);
         let (mut worst, mut away) = (0.0f64, 0);

@@ -310,6 +310,13 @@ impl Remesher<'_> {
     /// cheaper than [`Self::common_chart`] where any chart will do (orientation tests: the
     /// transitions preserve it).
     fn shared_chart<const N: usize>(&self, ids: [u32; N]) -> Option<[Complex64; N]> {
+        let home = self.verts[ids[0] as usize].point.chart;
+        if ids
+            .iter()
+            .all(|&i| self.verts[i as usize].point.chart == home)
+        {
+            return Some(ids.map(|i| self.verts[i as usize].point.coords));
+        }
         ids.iter().find_map(|&i| {
             let chart = self.verts[i as usize].point.chart;
             let mut coords = [Complex64::ZERO; N];
@@ -503,17 +510,21 @@ impl Remesher<'_> {
         ))
     }
 
-    /// The vertices adjacent to `v` (from its ring, which must be fresh).
-    fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut n: Vec<u32> = self
-            .ring(v)
+    /// How many vertices are neighbours of both `a` and `b`. Each neighbour of `a` lies in two of
+    /// its triangles (the mesh is a closed manifold), so it is met twice.
+    fn shared_neighbours(&self, a: u32, b: u32) -> usize {
+        let adjacent_to_b = |v: u32| {
+            self.ring(b)
+                .iter()
+                .any(|&t| self.tris[t as usize].contains(&v))
+        };
+        let meetings = self
+            .ring(a)
             .iter()
             .flat_map(|&t| self.tris[t as usize])
-            .filter(|&u| u != v)
-            .collect();
-        n.sort_unstable();
-        n.dedup();
-        n
+            .filter(|&v| v != a && v != b && adjacent_to_b(v))
+            .count();
+        meetings / 2
     }
 
     fn valence(&self, v: u32) -> usize {
@@ -667,9 +678,7 @@ impl Remesher<'_> {
             return false;
         }
         // The link condition: the ends share exactly the two wing vertices.
-        let (ng, nk) = (self.neighbours(gone), self.neighbours(kept));
-        let shared = ng.iter().filter(|v| nk.binary_search(v).is_ok()).count();
-        if shared != 2 {
+        if self.shared_neighbours(gone, kept) != 2 {
             return false;
         }
         let kept_pos = self.pos(kept);
@@ -679,17 +688,18 @@ impl Remesher<'_> {
             .iter()
             .filter(|&&t| t != t1 && t != t2)
             .map(|&t| self.tris[t as usize].map(|i| if i == gone { kept } else { i }));
-        if !self.folds(changed.clone()).no_worse_than(old_folds) {
-            return false;
-        }
-        // Where nothing was folded, no edge may come out longer than a split would leave.
+        // Where nothing was folded, no edge may come out longer than a split would leave (the
+        // cheap test first: most refusals are these).
         let too_long = |i: u32| {
             let limit = self.verts[i as usize]
                 .size
                 .min(self.verts[kept as usize].size);
             (self.pos(i) - kept_pos).norm() > 4.0 / 3.0 * limit
         };
-        if old_folds.none() && changed.flatten().any(|i| i != kept && too_long(i)) {
+        if old_folds.none() && changed.clone().flatten().any(|i| i != kept && too_long(i)) {
+            return false;
+        }
+        if !self.folds(changed).no_worse_than(old_folds) {
             return false;
         }
         // The wings die; gone's other triangles pass to kept (by the link condition none held
