@@ -160,7 +160,7 @@ pub fn quality_mesh(
         tolerance: settings.tolerance * diagonal,
         bend: settings.bend,
         max_edge: settings.max_edge * diagonal,
-        min_edge: 5e-4 * diagonal,
+        min_edge: 1e-4 * diagonal,
         verts: Vec::with_capacity(start.vertices.len()),
         tris: start.triangles,
         rings: Vec::new(),
@@ -186,12 +186,15 @@ pub fn quality_mesh(
     // Refine what is still turned away or bent, let the shapes settle, then make sure of the
     // tolerance.
     r.repeat(|r| r.split_folded());
-    r.repeat(|r| r.split_bent());
-    r.smooth(2);
-    r.repeat(|r| r.flip(FlipRule::Delaunay));
-    r.smooth(1);
-    r.repeat(|r| r.split_chordal());
-    r.repeat(|r| r.split_bent());
+    for last in [false, false, true] {
+        r.repeat(|r| r.split_bent());
+        r.repeat(|r| r.split_chordal());
+        // Splits can leave obtuse triangles; Delaunay flips that keep the tolerance mend them.
+        r.repeat(|r| r.flip(FlipRule::Delaunay));
+        if !last {
+            r.smooth(1);
+        }
+    }
     r.finish()
 }
 
@@ -796,6 +799,8 @@ impl Remesher<'_> {
     /// Gauss–Seidel sweeps moving each vertex part way towards the area-weighted centre of its
     /// triangles, within its tangent plane, where no triangle around it turns over.
     fn smooth(&mut self, sweeps: usize) {
+        // Moved corners make the chordal errors known so far stale.
+        self.chordal_fine.clear();
         for _ in 0..sweeps {
             for v in 0..self.verts.len() as u32 {
                 if !self.ring(v).is_empty() {
