@@ -28,7 +28,9 @@ fn main() {
         genera
     };
     let mut settings = QualitySettings::default();
-    if let Ok(r) = std::env::var("NTORI_ROUNDS") { settings.rounds = r.parse().unwrap(); }
+    if let Ok(r) = std::env::var("NTORI_ROUNDS") {
+        settings.rounds = r.parse().unwrap();
+    }
     println!(
         "genus  triangles  time(s)  t32-triangles  t32-time(s)  angles(°)      ≥20°(%)  ≥150°  bend(°)  away  chordal/diag"
     );
@@ -37,7 +39,9 @@ fn main() {
         let start = Instant::now();
         let q = quality_mesh(&s, &settings).expect("a quality mesh");
         let seconds = start.elapsed().as_secs_f64();
-        if std::env::var("NTORI_WHERE").is_ok() { report_bad(&s, &q); }
+        if std::env::var("NTORI_WHERE").is_ok() {
+            report_bad(&s, &q);
+        }
         let start = Instant::now();
         let tess = s.atlas().tessellate(32, 32).expect("a tessellation");
         let stencil = Stencil::build(&s.layout(), &tess.vertices);
@@ -93,22 +97,49 @@ pub fn report_bad(s: &Surface, q: &embedding::remesh::QualityMesh) {
     for (t, tri) in q.triangles.iter().enumerate() {
         let p = tri.map(|i| q.positions[i as usize]);
         let angle = |a: Point3, b: Point3, c: Point3| (b - a).angle(&(c - a)).to_degrees();
-        let big = angle(p[0], p[1], p[2]).max(angle(p[1], p[2], p[0])).max(angle(p[2], p[0], p[1]));
+        let big = angle(p[0], p[1], p[2])
+            .max(angle(p[1], p[2], p[0]))
+            .max(angle(p[2], p[0], p[1]));
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if let Some((u, other)) = q.triangles.iter().enumerate().find(|(_, o)| (0..3).any(|j| o[j] == b && o[(j + 1) % 3] == a)) {
-                let n = |t: &[u32; 3]| { let p = t.map(|i| q.positions[i as usize]); (p[1] - p[0]).cross(&(p[2] - p[0])).normalize() };
+            if let Some((u, other)) = q
+                .triangles
+                .iter()
+                .enumerate()
+                .find(|(_, o)| (0..3).any(|j| o[j] == b && o[(j + 1) % 3] == a))
+            {
+                let n = |t: &[u32; 3]| {
+                    let p = t.map(|i| q.positions[i as usize]);
+                    (p[1] - p[0]).cross(&(p[2] - p[0])).normalize()
+                };
                 let bend = n(tri).angle(&n(other)).to_degrees();
                 if bend > 20.0 && u > t {
                     let (k1, k2) = s.eval(q.vertices[a as usize]).principal_curvatures();
-                    println!("  bend {bend:.1}° |κ| {:.1} edge {:.2e} at {:?}", k1.abs().max(k2.abs()), (q.positions[a as usize] - q.positions[b as usize]).norm() / diagonal, q.positions[a as usize]);
+                    println!(
+                        "  bend {bend:.1}° |κ| {:.1} edge {:.2e} at {:?}",
+                        k1.abs().max(k2.abs()),
+                        (q.positions[a as usize] - q.positions[b as usize]).norm() / diagonal,
+                        q.positions[a as usize]
+                    );
                 }
             }
         }
         if big >= 150.0 {
-            let kappa = tri.iter().map(|&i| { let (k1, k2) = s.eval(q.vertices[i as usize]).principal_curvatures(); k1.abs().max(k2.abs()) }).fold(0.0, f64::max);
-            let longest = (0..3).map(|k| (p[k] - p[(k + 1) % 3]).norm()).fold(0.0, f64::max) / diagonal;
-            println!("  {big:.1}° chart {} |κ| {kappa:.1} longest {longest:.2e} at {:?}", q.triangle_charts[t].0, p[0]);
+            let kappa = tri
+                .iter()
+                .map(|&i| {
+                    let (k1, k2) = s.eval(q.vertices[i as usize]).principal_curvatures();
+                    k1.abs().max(k2.abs())
+                })
+                .fold(0.0, f64::max);
+            let longest = (0..3)
+                .map(|k| (p[k] - p[(k + 1) % 3]).norm())
+                .fold(0.0, f64::max)
+                / diagonal;
+            println!(
+                "  {big:.1}° chart {} |κ| {kappa:.1} longest {longest:.2e} at {:?}",
+                q.triangle_charts[t].0, p[0]
+            );
         }
     }
 }

@@ -51,6 +51,10 @@ pub const MAX_BEND: f64 = 18.0;
 /// settle a round).
 const MAX_PASSES: usize = 12;
 
+/// The most passes of collapses or valence flips in one round (their last passes change a few
+/// edges each, back and forth).
+const POLISH_PASSES: usize = 3;
+
 /// What the quality tessellation aims for.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QualitySettings {
@@ -70,7 +74,7 @@ impl Default for QualitySettings {
             tolerance: 1e-3,
             bend: 0.22,
             max_edge: 0.05,
-            rounds: 8,
+            rounds: 5,
         }
     }
 }
@@ -179,8 +183,9 @@ pub fn quality_mesh(
     for _ in 0..settings.rounds {
         r.grade_sizes();
         r.repeat(|r| r.split_long());
-        r.repeat(|r| r.collapse_short());
-        r.repeat(|r| r.flip(FlipRule::Valence));
+        // Collapses and valence flips polish: the next round picks up what a few passes leave.
+        r.repeat_at_most(POLISH_PASSES, |r| r.collapse_short());
+        r.repeat_at_most(POLISH_PASSES, |r| r.flip(FlipRule::Valence));
         r.smooth(1);
     }
     // Refine what is still turned away or bent, let the shapes settle, then make sure of the
@@ -195,6 +200,7 @@ pub fn quality_mesh(
             r.smooth(1);
         }
     }
+    r.repeat(|r| r.mend());
     r.finish()
 }
 
@@ -233,6 +239,8 @@ enum FlipRule {
     Valence,
     /// Where the two angles facing the edge sum to more than π (and the chordal error stays).
     Delaunay,
+    /// Where the pair's smallest angle grows (and the chordal error stays).
+    Mend,
 }
 
 impl Remesher<'_> {
@@ -458,9 +466,14 @@ impl Remesher<'_> {
 
     /// Runs passes of `pass` (which returns how many operations it made) until one makes none,
     /// at most [`MAX_PASSES`].
-    fn repeat(&mut self, mut pass: impl FnMut(&mut Self) -> usize) {
+    fn repeat(&mut self, pass: impl FnMut(&mut Self) -> usize) {
+        self.repeat_at_most(MAX_PASSES, pass);
+    }
+
+    /// Runs passes of `pass` until one makes no change, at most `passes`.
+    fn repeat_at_most(&mut self, passes: usize, mut pass: impl FnMut(&mut Self) -> usize) {
         let mut log = Vec::new();
-        for _ in 0..MAX_PASSES {
+        for _ in 0..passes {
             let n = pass(self);
             log.push(n);
             if n == 0 {
@@ -558,22 +571,90 @@ impl Remesher<'_> {
             let p = self.tris[t as usize].map(|i| self.pos(i));
             (p[1] - p[0]).cross(&(p[2] - p[0])).normalize()
         };
-        let bent: Vec<(u32, u32)> = self
-            .edges()
-            .into_iter()
-            .filter(|&(a, b)| match self.edge_wings(a, b) {
-                // A folded triangle's normal says nothing of the surface's bend.
-                Some((t1, _, t2, _)) => {
-                    normal(t1).dot(&normal(t2)) < limit
-                        && (self.pos(a) - self.pos(b)).norm() > 2.0 * self.min_edge
-                        && self
-                            .folds([t1, t2].map(|t| self.tris[t as usize]).into_iter())
-                            .none()
+        let mut bent = Vec::new();
+        for (a, b) in self.edges() {
+            // A folded triangle's normal says nothing of the surface's bend.
+            if let Some((t1, _, t2, _)) = self.edge_wings(a, b) {
+                let pair = [t1, t2].map(|t| self.tris[t as usize]);
+                if normal(t1).dot(&normal(t2)) < limit && self.folds(pair.into_iter()).none() {
+                    bent.extend(pair);
                 }
-                None => false,
-            })
+            }
+        }
+        // Bisecting each side's longest edge (Rivara) refines without thinning the triangles;
+        // splitting the bent edge itself where it is short makes slivers that bend as much.
+        bent.sort_unstable();
+        bent.dedup();
+        self.split_longest_edges(bent)
+    }
+
+    /// Flips an edge of every triangle with an angle under 20°, or else collapses its shortest
+    /// edge, where that makes the smallest angle around grow (a cap, with an angle of 150° or more,
+    /// has its other two under 15°).
+    fn mend(&mut self) -> usize {
+        let limit = 20f64.to_radians();
+        let bad: Vec<[u32; 3]> = self
+            .tris
+            .iter()
+            .filter(|t| t[0] != DEAD && self.smallest_angle(**t) < limit)
+            .copied()
             .collect();
-        bent.into_iter().filter(|&(a, b)| self.split(a, b)).count()
+        let mut count = 0;
+        for t in bad {
+            // Longest edge first: a cap's long edge is the one to flip.
+            let mut sides = [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
+            sides.sort_by(|x, y| {
+                let len = |(a, b): (u32, u32)| (self.pos(a) - self.pos(b)).norm();
+                len(*y).total_cmp(&len(*x))
+            });
+            // An earlier flip may have changed this triangle; `try_flip` finds what is there now.
+            if sides
+                .into_iter()
+                .any(|(a, b)| self.try_flip(a, b, FlipRule::Mend))
+            {
+                count += 1;
+                continue;
+            }
+            // A needle's shortest edge, or a cap's, collapsed.
+            let (a, b) = sides[2];
+            if self.collapse(a, b, true) || self.collapse(b, a, true) {
+                count += 1;
+            }
+        }
+        count
+    }
+
+    /// Whether triangles `new` may replace `old`: their smallest angle is larger, no triangle
+    /// tilts from its corners' normals more than the old ones did (or half of [`MAX_BEND`]), and
+    /// each is within the chordal tolerance.
+    fn mends(&self, old: &[[u32; 3]], new: &[[u32; 3]]) -> bool {
+        let least = |ts: &[[u32; 3]]| {
+            ts.iter()
+                .map(|&t| self.smallest_angle(t))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let tilt = |ts: &[[u32; 3]]| {
+            ts.iter()
+                .map(|&t| {
+                    let p = t.map(|i| self.pos(i));
+                    let n = (p[1] - p[0]).cross(&(p[2] - p[0]));
+                    t.iter()
+                        .map(|&i| n.angle(&self.verts[i as usize].normal))
+                        .fold(0.0, f64::max)
+                })
+                .fold(0.0, f64::max)
+        };
+        least(new) > least(old) + 1e-9
+            && tilt(new) <= tilt(old).max(0.5 * MAX_BEND.to_radians())
+            && new.iter().all(|&t| self.chordal_error(t) <= self.tolerance)
+    }
+
+    /// The triangle's smallest angle (radians).
+    fn smallest_angle(&self, t: [u32; 3]) -> f64 {
+        let p = t.map(|i| self.pos(i));
+        (0..3)
+            .map(|k| (p[(k + 1) % 3] - p[k]).angle(&(p[(k + 2) % 3] - p[k])))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Splits the longest edge of every triangle whose chordal error exceeds the tolerance.
@@ -631,10 +712,12 @@ impl Remesher<'_> {
             return false;
         };
         let m = self.verts.len() as u32;
-        // Halving a triangle in its chart keeps it counter-clockwise; check it all the same.
+        // Halving a triangle in its chart keeps it counter-clockwise, but where the surface bends
+        // sharply between a and b a child can face away from it.
         self.verts.push(mid);
         let children = [[a, m, c], [m, b, c], [b, m, d], [m, a, d]];
-        if children.iter().any(|&t| !self.counter_clockwise(t)) {
+        let old = self.folds([t1, t2].map(|t| self.tris[t as usize]).into_iter());
+        if !self.folds(children.into_iter()).no_worse_than(old) {
             self.verts.pop();
             return false;
         }
@@ -665,12 +748,13 @@ impl Remesher<'_> {
         short.sort_by(|x, y| x.0.total_cmp(&y.0));
         short
             .into_iter()
-            .filter(|&(_, a, b)| self.collapse(b, a) || self.collapse(a, b))
+            .filter(|&(_, a, b)| self.collapse(b, a, false) || self.collapse(a, b, false))
             .count()
     }
 
-    /// Moves `gone` onto `kept` and removes the two triangles of their edge.
-    fn collapse(&mut self, gone: u32, kept: u32) -> bool {
+    /// Moves `gone` onto `kept` and removes the two triangles of their edge. `mend`: for a sliver,
+    /// where the smallest angle around grows, instead of for a short edge.
+    fn collapse(&mut self, gone: u32, kept: u32, mend: bool) -> bool {
         let Some((t1, c, t2, d)) = self.edge_wings(kept, gone) else {
             return false;
         };
@@ -699,11 +783,19 @@ impl Remesher<'_> {
                 .min(self.verts[kept as usize].size);
             (self.pos(i) - kept_pos).norm() > 4.0 / 3.0 * limit
         };
-        if old_folds.none() && changed.clone().flatten().any(|i| i != kept && too_long(i)) {
+        if !mend && old_folds.none() && changed.clone().flatten().any(|i| i != kept && too_long(i))
+        {
             return false;
         }
-        if !self.folds(changed).no_worse_than(old_folds) {
+        if !self.folds(changed.clone()).no_worse_than(old_folds) {
             return false;
+        }
+        if mend {
+            let old: Vec<[u32; 3]> = ring.iter().map(|&t| self.tris[t as usize]).collect();
+            let new: Vec<[u32; 3]> = changed.collect();
+            if !self.mends(&old, &new) {
+                return false;
+            }
         }
         // The wings die; gone's other triangles pass to kept (by the link condition none held
         // kept before).
@@ -763,6 +855,11 @@ impl Remesher<'_> {
                 };
                 angle(c, a, b) + angle(d, b, a) > std::f64::consts::PI + 1e-9
             }
+            FlipRule::Mend => {
+                let least =
+                    |x: [u32; 3], y: [u32; 3]| self.smallest_angle(x).min(self.smallest_angle(y));
+                least([a, d, c], [d, b, c]) > least([a, b, c], [b, a, d]) + 1e-9
+            }
         };
         if !wanted {
             return false;
@@ -781,7 +878,7 @@ impl Remesher<'_> {
         if old_folds.none() && normal(n1).dot(&normal(n2)) < old.min(0.98) {
             return false;
         }
-        if rule == FlipRule::Delaunay
+        if rule != FlipRule::Valence
             && (self.chordal_error(n1) > self.tolerance || self.chordal_error(n2) > self.tolerance)
         {
             return false;
