@@ -178,7 +178,7 @@ pub fn quality_mesh(
     // The start's triangles wind counter-clockwise in their charts, which is outward.
     // Clean the start's slivers before refining: splitting a sliver makes more of them.
     r.repeat(|r| r.collapse_short());
-    r.repeat(|r| r.flip(FlipRule::Valence));
+    r.repeat_at_most(POLISH_PASSES, |r| r.flip(FlipRule::Valence));
     r.smooth(2);
     for _ in 0..settings.rounds {
         r.grade_sizes();
