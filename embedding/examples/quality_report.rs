@@ -1,7 +1,8 @@
 //! Issue 15's quality tessellation over the example models: triangle count and time against the
 //! t_e = t_r = 32 tessellation, triangle angles, the largest bend between neighbours, triangles
 //! facing away from the surface, and the chordal error.
-//! `cargo run --release -p embedding --example quality_report [GENERA…]`
+//! `cargo run --release -p embedding --example quality_report [GENERA…]`; `NTORI_ROUNDS=R` sets
+//! the rounds, `NTORI_WHERE=1` lists the triangles that miss the targets.
 use std::time::Instant;
 
 use embedding::remesh::{QualitySettings, quality_mesh};

@@ -472,16 +472,10 @@ impl Remesher<'_> {
 
     /// Runs passes of `pass` until one makes no change, at most `passes`.
     fn repeat_at_most(&mut self, passes: usize, mut pass: impl FnMut(&mut Self) -> usize) {
-        let mut log = Vec::new();
         for _ in 0..passes {
-            let n = pass(self);
-            log.push(n);
-            if n == 0 {
+            if pass(self) == 0 {
                 break;
             }
-        }
-        if std::env::var("NTORI_REMESH_LOG").is_ok() {
-            eprintln!("{log:?}");
         }
     }
 
@@ -560,7 +554,7 @@ impl Remesher<'_> {
             .collect();
         long.sort_by(|x, y| y.0.total_cmp(&x.0));
         long.into_iter()
-            .filter(|&(_, a, b)| self.split(a, b))
+            .filter(|&(_, a, b)| self.split(a, b, true))
             .count()
     }
 
@@ -700,11 +694,17 @@ impl Remesher<'_> {
             })
             .filter(|&(a, b)| (self.pos(a) - self.pos(b)).norm() > self.min_edge)
             .collect();
-        edges.into_iter().filter(|&(a, b)| self.split(a, b)).count()
+        edges
+            .into_iter()
+            .filter(|&(a, b)| self.split(a, b, false))
+            .count()
     }
 
     /// Splits edge a–b at the surface point midway in chart coordinates.
-    fn split(&mut self, a: u32, b: u32) -> bool {
+    /// `sizing`: a split for the target length, refused where a child would face away from the
+    /// surface more than its parents did. Otherwise a split that refines a triangle that is too
+    /// coarse or faces away, where only the orientation in the chart is kept.
+    fn split(&mut self, a: u32, b: u32, sizing: bool) -> bool {
         let Some((t1, c, t2, d)) = self.edge_wings(a, b) else {
             return false;
         };
@@ -717,7 +717,8 @@ impl Remesher<'_> {
         self.verts.push(mid);
         let children = [[a, m, c], [m, b, c], [b, m, d], [m, a, d]];
         let old = self.folds([t1, t2].map(|t| self.tris[t as usize]).into_iter());
-        if !self.folds(children.into_iter()).no_worse_than(old) {
+        let new = self.folds(children.into_iter());
+        if new.turned > 0 || (sizing && !new.no_worse_than(old)) {
             self.verts.pop();
             return false;
         }
