@@ -30,7 +30,7 @@ fn main() {
     };
     let mut settings = QualitySettings::default();
     if let Ok(r) = std::env::var("NTORI_ROUNDS") {
-        settings.rounds = r.parse().unwrap();
+        settings.rounds = r.parse().expect("NTORI_ROUNDS: a number of rounds");
     }
     println!(
         "genus  triangles  time(s)  t32-triangles  t32-time(s)  angles(°)      ≥20°(%)  ≥150°  bend(°)  away  chordal/diag"
@@ -64,20 +64,8 @@ fn main() {
             "genus {genus}"
         );
         let shape = mesh::mesh_shape(&pos, &q.triangles).expect("a mesh");
-        let diagonal = embedding::fit::diagonal(&q.positions);
-        let (mut worst, mut away) = (0.0f64, 0);
-        for (t, tri) in q.triangles.iter().enumerate() {
-            let mean = q.triangle_coords[t].iter().sum::<num_complex::Complex64>() / 3.0;
-            let exact = s.eval(charts::ChartPoint::new(q.triangle_charts[t], mean));
-            let [a, b, c] = tri.map(|i| q.positions[i as usize]);
-            worst = worst.max(
-                (exact.pos - Point3::from((a.coords + b.coords + c.coords) / 3.0)).norm()
-                    / diagonal,
-            );
-            if (b - a).cross(&(c - a)).dot(&exact.normal()) <= 0.0 {
-                away += 1;
-            }
-        }
+        let fidelity = q.fidelity(&s);
+        let (worst, away) = (fidelity.chordal_error, fidelity.facing_away);
         println!(
             "{genus:5}  {:9}  {seconds:7.2}  {:13}  {t32:11.2}  {:5.1}–{:5.1}  {:7.2}  {:5}  {:7.1}  {away:4}  {worst:.2e}",
             q.triangles.len(),
@@ -91,10 +79,18 @@ fn main() {
     }
 }
 
-/// Prints where the triangles with an angle ≥ 150° are: chart, the largest |κ| at their corners,
-/// their longest edge over the diagonal. `NTORI_WHERE=1`.
+/// Prints the edges bending more than 20° (with |κ| and length over the diagonal) and the
+/// triangles with an angle ≥ 150° (chart, largest |κ| at their corners, longest edge over the
+/// diagonal). `NTORI_WHERE=1`.
 pub fn report_bad(s: &Surface, q: &embedding::remesh::QualityMesh) {
     let diagonal = embedding::fit::diagonal(&q.positions);
+    // Directed edge → its triangle, to find each edge's other side.
+    let owner: std::collections::HashMap<(u32, u32), usize> = q
+        .triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, tri)| (0..3).map(move |k| ((tri[k], tri[(k + 1) % 3]), t)))
+        .collect();
     for (t, tri) in q.triangles.iter().enumerate() {
         let p = tri.map(|i| q.positions[i as usize]);
         let angle = |a: Point3, b: Point3, c: Point3| (b - a).angle(&(c - a)).to_degrees();
@@ -103,12 +99,8 @@ pub fn report_bad(s: &Surface, q: &embedding::remesh::QualityMesh) {
             .max(angle(p[2], p[0], p[1]));
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if let Some((u, other)) = q
-                .triangles
-                .iter()
-                .enumerate()
-                .find(|(_, o)| (0..3).any(|j| o[j] == b && o[(j + 1) % 3] == a))
-            {
+            if let Some(&u) = owner.get(&(b, a)) {
+                let other = &q.triangles[u];
                 let n = |t: &[u32; 3]| {
                     let p = t.map(|i| q.positions[i as usize]);
                     (p[1] - p[0]).cross(&(p[2] - p[0])).normalize()

@@ -316,8 +316,15 @@ pub fn cut(mesh: &HoledMesh) -> Result<CutDisk, EmbeddingError> {
             [0, 1, 2].map(|k| copy[(hs.start + k) as usize])
         })
         .collect();
-    let start = original.iter().position(|&o| o == mesh.base);
-    let boundary = boundary_cycle(original.len(), &triangles, start)?;
+    let start = original
+        .iter()
+        .position(|&o| o == mesh.base)
+        .ok_or_else(|| fail("the base vertex is not on the cut"))?;
+    let boundary =
+        boundary_cycle(original.len(), &triangles, Some(start as u32)).map_err(|e| match e {
+            EmbeddingError::Parameterization(why) => fail(&format!("the cut mesh: {why}")),
+            other => other,
+        })?;
     let arcs = label_arcs(mesh, &original, &boundary)?;
     Ok(CutDisk {
         original,
@@ -327,12 +334,13 @@ pub fn cut(mesh: &HoledMesh) -> Result<CutDisk, EmbeddingError> {
     })
 }
 
-/// The boundary of a disk (its half-edges without a twin) as one counter-clockwise cycle of
-/// vertices, from `start`.
-fn boundary_cycle(
+/// The boundary of a disk of counter-clockwise triangles (its half-edges without a twin) as one
+/// counter-clockwise cycle of vertices, from `start` (by default its smallest vertex). Vertices no
+/// triangle uses are allowed.
+pub(crate) fn boundary_cycle(
     vertex_count: usize,
     triangles: &[[u32; 3]],
-    start: Option<usize>,
+    start: Option<u32>,
 ) -> Result<Vec<u32>, EmbeddingError> {
     let fail = |what: &str| EmbeddingError::Parameterization(what.to_string());
     let he = HalfEdgeMesh::from_polygons(vertex_count, triangles.iter().map(|t| &t[..]))
@@ -340,29 +348,28 @@ fn boundary_cycle(
     let mut next = HashMap::new();
     for h in (0..he.halfedge_count() as u32).filter(|&h| he.twin(h).is_none()) {
         if next.insert(he.origin(h), he.target(h)).is_some() {
-            return Err(fail(
-                "the cut mesh is not a disk (a boundary vertex repeats)",
-            ));
+            return Err(fail("not a disk (a boundary vertex repeats)"));
         }
     }
-    let start = start.ok_or_else(|| fail("the base vertex is not on the cut"))? as u32;
+    let start = match start {
+        Some(s) => s,
+        None => *next.keys().min().ok_or_else(|| fail("no boundary"))?,
+    };
     let mut cycle = vec![start];
     let mut v = *next
         .get(&start)
-        .ok_or_else(|| fail("the base vertex is not on the cut"))?;
+        .ok_or_else(|| fail("the base vertex is not on the boundary"))?;
     while v != start {
         cycle.push(v);
         v = *next
             .get(&v)
-            .ok_or_else(|| fail("the cut's boundary is not closed"))?;
+            .ok_or_else(|| fail("the boundary is not closed"))?;
         if cycle.len() > next.len() {
-            return Err(fail("the cut's boundary is not one cycle"));
+            return Err(fail("the boundary is not one cycle"));
         }
     }
     if cycle.len() != next.len() {
-        return Err(fail(
-            "the cut leaves more than one boundary: it is not a disk",
-        ));
+        return Err(fail("more than one boundary: not a disk"));
     }
     Ok(cycle)
 }

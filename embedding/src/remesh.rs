@@ -110,6 +110,44 @@ pub struct QualityMesh {
     pub triangle_coords: Vec<[Complex64; 3]>,
 }
 
+/// How closely a [`QualityMesh`] follows its surface, measured at each triangle's centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fidelity {
+    /// The largest distance between a flat triangle's centre and the surface at its corners' mean
+    /// chart coordinates, as a fraction of the mesh's bounding-box diagonal.
+    pub chordal_error: f64,
+    /// Triangles whose normal points against the surface's there.
+    pub facing_away: usize,
+}
+
+impl QualityMesh {
+    /// Measures the mesh against the exact surface (not through the remesher's own bookkeeping).
+    pub fn fidelity(&self, surface: &Surface) -> Fidelity {
+        let diagonal = crate::fit::diagonal(&self.positions);
+        let mut f = Fidelity {
+            chordal_error: 0.0,
+            facing_away: 0,
+        };
+        for (t, tri) in self.triangles.iter().enumerate() {
+            let mean = self.triangle_coords[t].iter().sum::<Complex64>() / 3.0;
+            let exact = surface.eval(ChartPoint::new(self.triangle_charts[t], mean));
+            let [a, b, c] = tri.map(|i| self.positions[i as usize]);
+            let flat = Point3::from((a.coords + b.coords + c.coords) / 3.0);
+            f.chordal_error = f.chordal_error.max((exact.pos - flat).norm() / diagonal);
+            if (b - a).cross(&(c - a)).dot(&exact.normal()) <= 0.0 {
+                f.facing_away += 1;
+            }
+        }
+        f
+    }
+}
+
+/// How many vertices the remesher starts from on this atlas (the squares of the t_e =
+/// [`START_RESOLUTION`] tessellation and the triangulated wheels).
+pub fn start_vertex_count(atlas: &charts::Atlas) -> Result<usize, EmbeddingError> {
+    Ok(start::start_mesh(atlas, START_RESOLUTION)?.vertices.len())
+}
+
 /// A vertex being remeshed.
 #[derive(Clone, Debug)]
 struct Vertex {

@@ -188,6 +188,23 @@ fn the_quality_tessellation_is_well_shaped_and_within_tolerance_at_genus_9_and_1
     check_quality_tessellation(&[9, 10]);
 }
 
+/// The fidelity measure sees a moved vertex and a turned triangle.
+#[test]
+fn fidelity_finds_a_moved_vertex_and_a_turned_triangle() {
+    use embedding::remesh::{QualitySettings, quality_mesh};
+    let s = asset(0);
+    let mut q = quality_mesh(&s, &QualitySettings::default()).unwrap();
+    let before = q.fidelity(&s);
+    assert_eq!(before.facing_away, 0);
+    let diagonal = embedding::fit::diagonal(&q.positions);
+    q.positions[0].x += 0.05 * diagonal;
+    let moved = q.fidelity(&s);
+    // The centres of the triangles around vertex 0 move by a third of that.
+    assert!(moved.chordal_error > 0.015, "{moved:?}");
+    q.triangles[0].swap(1, 2);
+    assert_eq!(q.fidelity(&s).facing_away, 1);
+}
+
 fn check_quality_tessellation(genera: &[u32]) {
     use embedding::remesh::{QualitySettings, quality_mesh};
     let settings = QualitySettings::default();
@@ -218,19 +235,8 @@ fn check_quality_tessellation(genera: &[u32]) {
             "genus {genus}"
         );
         let shape = mesh::mesh_shape(&positions, &q.triangles).unwrap();
-        let diagonal = embedding::fit::diagonal(&q.positions);
-        let mut worst = 0.0f64;
-        let mut folded = 0;
-        for (t, tri) in q.triangles.iter().enumerate() {
-            let mean = q.triangle_coords[t].iter().sum::<num_complex::Complex64>() / 3.0;
-            let exact = s.eval(charts::ChartPoint::new(q.triangle_charts[t], mean));
-            let [a, b, c] = tri.map(|i| q.positions[i as usize]);
-            let flat = Point3::from((a.coords + b.coords + c.coords) / 3.0);
-            worst = worst.max((exact.pos - flat).norm() / diagonal);
-            if (b - a).cross(&(c - a)).dot(&exact.normal()) <= 0.0 {
-                folded += 1;
-            }
-        }
+        let fidelity = q.fidelity(&s);
+        let (worst, folded) = (fidelity.chordal_error, fidelity.facing_away);
         println!(
             "genus {genus}: {} vertices, {} triangles in {:.2?}; angles {:.1}°–{:.1}°, {:.2}% ≥ 20°, {} ≥ 150°, bend ≤ {:.1}°, chordal error ≤ {:.2e} of the diagonal",
             q.vertices.len(),

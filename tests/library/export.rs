@@ -568,8 +568,7 @@ fn bad_resolutions_and_degenerate_surfaces_are_refused() {
     assert!(matches!(err, ExportError::Degenerate { .. }), "{err}");
     // The quality tessellation refuses it too, counting the vertices it would start from.
     let err = export::quality_surface_mesh(&point, 1e-3, UvLayout::Chart).unwrap_err();
-    let start = embedding::remesh::START_RESOLUTION;
-    let expected = charts::Tessellation::expected_vertices(point.genus(), start, start) as usize;
+    let expected = embedding::remesh::start_vertex_count(point.atlas()).unwrap();
     assert!(
         matches!(err, ExportError::Degenerate { count, .. } if count == expected),
         "{err}"

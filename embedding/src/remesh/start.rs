@@ -49,8 +49,12 @@ pub(super) fn start_mesh(atlas: &Atlas, resolution: u32) -> Result<StartMesh, Em
                 coords.insert(tess.triangles[t][k], tess.triangle_coords[t][k]);
             }
         }
-        let boundary = boundary_loop(wheel.iter().map(|&t| tess.triangles[t]))
-            .ok_or_else(|| wheel_error(chart, "its boundary is not one loop"))?;
+        let fan: Vec<[u32; 3]> = wheel.iter().map(|&t| tess.triangles[t]).collect();
+        let boundary =
+            crate::fit::boundary_cycle(tess.vertices.len(), &fan, None).map_err(|e| match e {
+                EmbeddingError::Parameterization(why) => wheel_error(chart, &why),
+                other => other,
+            })?;
         let outline: Vec<Complex64> = boundary.iter().map(|i| coords[i]).collect();
         let (ids, faces) = triangulate_disk(&outline).map_err(|why| wheel_error(chart, &why))?;
         let ids: Vec<u32> = ids
@@ -73,33 +77,6 @@ fn wheel_error(chart: ChartId, why: &str) -> EmbeddingError {
         "cannot triangulate the wheel of chart {}: {why}",
         chart.0
     ))
-}
-
-/// The boundary of a disk of counter-clockwise triangles as one counter-clockwise loop of
-/// vertices; `None` if the boundary is not a single loop.
-fn boundary_loop(triangles: impl Iterator<Item = [u32; 3]>) -> Option<Vec<u32>> {
-    let mut directed = HashSet::new();
-    for t in triangles {
-        for k in 0..3 {
-            directed.insert((t[k], t[(k + 1) % 3]));
-        }
-    }
-    let next: HashMap<u32, u32> = directed
-        .iter()
-        .filter(|&&(a, b)| !directed.contains(&(b, a)))
-        .copied()
-        .collect();
-    let &first = next.keys().min()?;
-    let mut boundary = vec![first];
-    let mut v = *next.get(&first)?;
-    while v != first {
-        if boundary.len() >= next.len() {
-            return None;
-        }
-        boundary.push(v);
-        v = *next.get(&v)?;
-    }
-    (boundary.len() == next.len()).then_some(boundary)
 }
 
 /// A vertex of [`triangulate_disk`]'s output: a boundary point by its index, or a new one inside.

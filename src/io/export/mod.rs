@@ -361,11 +361,9 @@ pub fn quality_surface_mesh(
     uv: UvLayout,
 ) -> Result<SurfaceMesh, ExportError> {
     // Refused before remeshing, counting the vertices the remesher would start from.
-    let start = remesh::START_RESOLUTION;
-    check_not_degenerate(
-        surface,
-        Tessellation::expected_vertices(surface.genus(), start, start),
-    )?;
+    if surface.is_degenerate() {
+        check_not_degenerate(surface, remesh::start_vertex_count(surface.atlas())? as u64)?;
+    }
     let settings = QualitySettings {
         tolerance,
         ..QualitySettings::default()
