@@ -32,6 +32,7 @@ use std::collections::HashSet;
 
 use charts::{ChartId, ChartPoint};
 use num_complex::Complex64;
+use rayon::prelude::*;
 
 use crate::{EmbeddingError, Point3, Surface, Vector3};
 
@@ -180,6 +181,12 @@ struct Remesher<'a> {
     rings: Vec<Vec<u32>>,
     /// Triangles (by corners) whose chordal error is known to be within the tolerance.
     chordal_fine: HashSet<[u32; 3]>,
+    /// The pass in which each vertex last moved or changed its ring (see [`Remesher::repeat`]).
+    changed: Vec<u32>,
+    /// The pass now running.
+    pass: u32,
+    /// Passes look only at what changed from this pass on (0: everything).
+    since: u32,
 }
 
 /// Remeshes `surface` into a [`QualityMesh`] (see the module documentation).
@@ -207,6 +214,9 @@ pub fn quality_mesh(
         tris: start.triangles,
         rings: Vec::new(),
         chordal_fine: HashSet::new(),
+        changed: Vec::new(),
+        pass: 0,
+        since: 0,
     };
     for &p in &start.vertices {
         let v = r.vertex(p).ok_or_else(|| pinched(p))?;
@@ -387,13 +397,13 @@ impl Remesher<'_> {
     /// Distance between the flat triangle's centre and the surface at its corners' mean chart
     /// coordinates (infinite where no chart holds all three corners).
     fn chordal_error(&self, t: [u32; 3]) -> f64 {
-        match self.centre(t) {
-            Some(c) => {
-                let flat = self.centroid(t);
-                (c.pos - flat).norm()
-            }
-            None => f64::INFINITY,
-        }
+        let Some((chart, coords)) = self.common_chart(t) else {
+            return f64::INFINITY;
+        };
+        // Chart domains are convex, so the mean lies in the chart.
+        let mean = coords.iter().sum::<Complex64>() / 3.0;
+        let exact = self.surface.position(ChartPoint::new(chart, mean));
+        (exact - self.centroid(t)).norm()
     }
 
     fn centroid(&self, t: [u32; 3]) -> Point3 {
@@ -482,6 +492,7 @@ impl Remesher<'_> {
     /// Builds the rings from the triangles (the operations then keep them up to date).
     fn build_rings(&mut self) {
         self.rings = vec![Vec::new(); self.verts.len()];
+        self.changed = vec![0; self.verts.len()];
         for (t, tri) in self.tris.iter().enumerate() {
             if tri[0] != DEAD {
                 for &v in tri {
@@ -508,26 +519,63 @@ impl Remesher<'_> {
         self.repeat_at_most(MAX_PASSES, pass);
     }
 
-    /// Runs passes of `pass` until one makes no change, at most `passes`.
+    /// Runs passes of `pass` until one makes no change, at most `passes`. The first pass looks at
+    /// the whole mesh; each later one only at the triangles around vertices the pass before
+    /// changed (every test an operation makes depends on its edge's two triangles and their
+    /// corners' rings, so elsewhere the answer would be the same as before). Late passes change
+    /// a few dozen edges of tens of thousands.
     fn repeat_at_most(&mut self, passes: usize, mut pass: impl FnMut(&mut Self) -> usize) {
+        self.since = 0;
         for _ in 0..passes {
-            if pass(self) == 0 {
+            self.pass += 1;
+            let started = self.pass;
+            let made = pass(self);
+            self.since = started;
+            if made == 0 {
                 break;
             }
         }
+        self.since = 0;
     }
 
-    /// The edges (a < b) of the live triangles, each once (a closed manifold mesh holds a→b in
-    /// one triangle and b→a in another), in triangle order: the same input gives the same mesh.
+    /// Marks `v` as changed in this pass.
+    fn touch(&mut self, v: u32) {
+        self.changed[v as usize] = self.pass;
+    }
+
+    /// The live triangles the running pass looks at: all, or those with a corner that changed
+    /// since [`Remesher::since`].
+    fn live_triangles(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
+        self.tris.iter().copied().filter(|t| {
+            t[0] != DEAD
+                && (self.since == 0 || t.iter().any(|&v| self.changed[v as usize] >= self.since))
+        })
+    }
+
+    /// The edges (a < b) of the triangles the running pass looks at, each once (a closed manifold
+    /// mesh holds a→b in one triangle and b→a in another), in triangle order on a first pass:
+    /// the same input gives the same mesh.
     fn edges(&self) -> Vec<(u32, u32)> {
         let mut edges = Vec::with_capacity(self.tris.len() * 3 / 2);
-        for tri in self.tris.iter().filter(|t| t[0] != DEAD) {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                if a < b {
-                    edges.push((a, b));
+        if self.since == 0 {
+            for tri in self.live_triangles() {
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    if a < b {
+                        edges.push((a, b));
+                    }
                 }
             }
+        } else {
+            // An edge's other triangle may be the one that changed: take every edge both ways.
+            for tri in self.live_triangles() {
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    edges.push((a.min(b), a.max(b)));
+                }
+            }
+            edges.sort_unstable();
+            edges.dedup();
         }
         edges
     }
@@ -591,9 +639,7 @@ impl Remesher<'_> {
             .filter(|e| e.0 > 4.0 / 3.0)
             .collect();
         long.sort_by(|x, y| y.0.total_cmp(&x.0));
-        long.into_iter()
-            .filter(|&(_, a, b)| self.split(a, b, true))
-            .count()
+        self.split_edges(long.into_iter().map(|(_, a, b)| (a, b)).collect(), true)
     }
 
     /// Splits every edge across which the triangles' normals turn by more than [`MAX_BEND`].
@@ -626,10 +672,8 @@ impl Remesher<'_> {
     fn mend(&mut self) -> usize {
         let limit = 20f64.to_radians();
         let bad: Vec<[u32; 3]> = self
-            .tris
-            .iter()
-            .filter(|t| t[0] != DEAD && self.smallest_angle(**t) < limit)
-            .copied()
+            .live_triangles()
+            .filter(|&t| self.smallest_angle(t) < limit)
             .collect();
         let mut count = 0;
         for t in bad {
@@ -691,16 +735,22 @@ impl Remesher<'_> {
 
     /// Splits the longest edge of every triangle whose chordal error exceeds the tolerance.
     fn split_chordal(&mut self) -> usize {
+        let unknown: Vec<[u32; 3]> = self
+            .live_triangles()
+            .filter(|t| !self.chordal_fine.contains(t))
+            .collect();
+        // One surface evaluation per triangle: the pass's work, shared among the cores.
+        let fine: Vec<bool> = unknown
+            .par_iter()
+            .map(|&t| self.chordal_error(t) <= self.tolerance)
+            .collect();
         let mut bad = Vec::new();
-        for t in &self.tris {
-            if t[0] == DEAD || self.chordal_fine.contains(t) {
-                continue;
+        for (t, fine) in unknown.into_iter().zip(fine) {
+            if fine {
+                self.chordal_fine.insert(t);
+            } else {
+                bad.push(t);
             }
-            if self.chordal_error(*t) <= self.tolerance {
-                self.chordal_fine.insert(*t);
-                continue;
-            }
-            bad.push(*t);
         }
         self.split_longest_edges(bad)
     }
@@ -709,10 +759,8 @@ impl Remesher<'_> {
     /// the right way in its chart: too large for the curvature there.
     fn split_folded(&mut self) -> usize {
         let bad: Vec<[u32; 3]> = self
-            .tris
-            .iter()
-            .filter(|t| t[0] != DEAD && self.folds(std::iter::once(**t)).facing_away > 0)
-            .copied()
+            .live_triangles()
+            .filter(|&t| self.folds(std::iter::once(t)).facing_away > 0)
             .collect();
         self.split_longest_edges(bad)
     }
@@ -732,9 +780,21 @@ impl Remesher<'_> {
             })
             .filter(|&(a, b)| (self.pos(a) - self.pos(b)).norm() > self.min_edge)
             .collect();
+        self.split_edges(edges, false)
+    }
+
+    /// Splits each edge that still exists when its turn comes (see [`Remesher::split`]); the
+    /// midpoints, the pass's surface evaluations, are found first on all cores (a split moves no
+    /// vertex, so they stay right).
+    fn split_edges(&mut self, edges: Vec<(u32, u32)>, sizing: bool) -> usize {
+        let mids: Vec<Option<Vertex>> = edges.par_iter().map(|&(a, b)| self.centre([a, b])).collect();
         edges
             .into_iter()
-            .filter(|&(a, b)| self.split(a, b, false))
+            .zip(mids)
+            .filter(|&((a, b), ref mid)| match mid {
+                Some(mid) => self.split(a, b, mid.clone(), sizing),
+                None => false,
+            })
             .count()
     }
 
@@ -742,11 +802,8 @@ impl Remesher<'_> {
     /// `sizing`: a split for the target length, refused where a child would face away from the
     /// surface more than its parents did. Otherwise a split that refines a triangle that is too
     /// coarse or faces away, where only the orientation in the chart is kept.
-    fn split(&mut self, a: u32, b: u32, sizing: bool) -> bool {
+    fn split(&mut self, a: u32, b: u32, mid: Vertex, sizing: bool) -> bool {
         let Some((t1, c, t2, d)) = self.edge_wings(a, b) else {
-            return false;
-        };
-        let Some(mid) = self.centre([a, b]) else {
             return false;
         };
         let m = self.verts.len() as u32;
@@ -772,6 +829,10 @@ impl Remesher<'_> {
         self.rings[c as usize].push(t3);
         self.rings[d as usize].push(t4);
         self.rings[m as usize] = vec![t1, t3, t2, t4];
+        self.changed.push(0);
+        for v in [a, b, c, d, m] {
+            self.touch(v);
+        }
         true
     }
 
@@ -803,29 +864,30 @@ impl Remesher<'_> {
         {
             return false;
         }
-        // The link condition: the ends share exactly the two wing vertices.
-        if self.shared_neighbours(gone, kept) != 2 {
-            return false;
-        }
         let kept_pos = self.pos(kept);
         let ring = self.ring(gone);
-        let old_folds = self.folds(ring.iter().map(|&t| self.tris[t as usize]));
         let changed = ring
             .iter()
             .filter(|&&t| t != t1 && t != t2)
             .map(|&t| self.tris[t as usize].map(|i| if i == gone { kept } else { i }));
-        // Where nothing was folded, no edge may come out longer than a split would leave (the
-        // cheap test first: most refusals are these).
+        let old_folds = || self.folds(ring.iter().map(|&t| self.tris[t as usize]));
+        // Where nothing was folded, no edge may come out longer than a split would leave. Most
+        // refusals are these: the cheap test goes first.
         let too_long = |i: u32| {
             let limit = self.verts[i as usize]
                 .size
                 .min(self.verts[kept as usize].size);
             (self.pos(i) - kept_pos).norm() > 4.0 / 3.0 * limit
         };
-        if !mend && old_folds.none() && changed.clone().flatten().any(|i| i != kept && too_long(i))
-        {
+        let stretches = || changed.clone().flatten().any(|i| i != kept && too_long(i));
+        if !mend && stretches() && old_folds().none() {
             return false;
         }
+        // The link condition: the ends share exactly the two wing vertices.
+        if self.shared_neighbours(gone, kept) != 2 {
+            return false;
+        }
+        let old_folds = old_folds();
         if !self.folds(changed.clone()).no_worse_than(old_folds) {
             return false;
         }
@@ -852,6 +914,13 @@ impl Remesher<'_> {
         }
         for (v, t) in [(kept, t1), (kept, t2), (c, t1), (d, t2)] {
             self.ring_remove(v, t);
+        }
+        // kept's new triangles are the ones whose shape changed.
+        for i in 0..self.rings[kept as usize].len() {
+            let t = self.rings[kept as usize][i];
+            for v in self.tris[t as usize] {
+                self.touch(v);
+            }
         }
         true
     }
@@ -929,24 +998,37 @@ impl Remesher<'_> {
         self.ring_remove(b, t1);
         self.rings[c as usize].push(t2);
         self.rings[d as usize].push(t1);
+        for v in [a, b, c, d] {
+            self.touch(v);
+        }
         true
     }
 
-    /// Gauss–Seidel sweeps moving each vertex part way towards the area-weighted centre of its
-    /// triangles, within its tangent plane, where no triangle around it turns over.
+    /// Sweeps moving each vertex part way towards the area-weighted centre of its triangles,
+    /// within its tangent plane, where no triangle around it turns over or comes to face away.
+    /// Each sweep finds every vertex's new place on all cores from the old places (Jacobi), then
+    /// moves them one by one, each where the triangles around it, as they are by then, allow.
     fn smooth(&mut self, sweeps: usize) {
         // Moved corners make the chordal errors known so far stale.
         self.chordal_fine.clear();
         for _ in 0..sweeps {
-            for v in 0..self.verts.len() as u32 {
-                if !self.ring(v).is_empty() {
-                    self.relax(v);
+            let moved: Vec<Option<Vertex>> = (0..self.verts.len() as u32)
+                .into_par_iter()
+                .map(|v| self.relaxed(v))
+                .collect();
+            for (v, moved) in moved.into_iter().enumerate() {
+                if let Some(moved) = moved {
+                    self.move_vertex(v as u32, moved);
                 }
             }
         }
     }
 
-    fn relax(&mut self, v: u32) {
+    /// Where smoothing would move `v` (`None`: nowhere, or `v` is gone).
+    fn relaxed(&self, v: u32) -> Option<Vertex> {
+        if self.ring(v).is_empty() {
+            return None;
+        }
         let vert = &self.verts[v as usize];
         let (mut sum, mut weight) = (Vector3::zeros(), 0.0);
         for &t in self.ring(v) {
@@ -957,7 +1039,7 @@ impl Remesher<'_> {
             weight += area;
         }
         if weight.is_nan() || weight <= 0.0 {
-            return;
+            return None;
         }
         let step = (sum / weight - vert.pos.coords) * 0.6;
         let step = step - vert.normal * step.dot(&vert.normal);
@@ -969,19 +1051,22 @@ impl Remesher<'_> {
         );
         let det = e * g - f * f;
         if det.is_nan() || det <= 0.0 {
-            return;
+            return None;
         }
         let (ru, rv) = (vert.du.dot(&step), vert.dv.dot(&step));
         let dw = Complex64::new((g * ru - f * rv) / det, (e * rv - f * ru) / det);
-        let Some(moved) = self.vertex(ChartPoint::new(vert.point.chart, vert.point.coords + dw))
-        else {
-            return;
-        };
+        self.vertex(ChartPoint::new(vert.point.chart, vert.point.coords + dw))
+    }
+
+    /// Puts `v` at `moved` where that leaves the triangles around it no worse folded.
+    fn move_vertex(&mut self, v: u32, moved: Vertex) {
         let around = |r: &Self| r.folds(r.ring(v).iter().map(|&t| r.tris[t as usize]));
         let old_folds = around(self);
         let saved = std::mem::replace(&mut self.verts[v as usize], moved);
         let new_folds = around(self);
-        if !new_folds.no_worse_than(old_folds) {
+        if new_folds.no_worse_than(old_folds) {
+            self.touch(v);
+        } else {
             self.verts[v as usize] = saved;
         }
     }

@@ -147,6 +147,11 @@ impl Surface {
         self.layout().eval(&self.control, p)
     }
 
+    /// S at `p` (no derivatives: cheaper than [`Surface::eval`]).
+    pub fn position(&self, p: ChartPoint) -> Point3 {
+        self.layout().position(&self.control, p)
+    }
+
     /// The diagonal of the control points' bounding box: the scale derivatives in chart units have.
     pub fn control_net_size(&self) -> f64 {
         crate::fit::diagonal(&self.control)

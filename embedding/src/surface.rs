@@ -333,6 +333,31 @@ impl<'a> Layout<'a> {
             .collect()
     }
 
+    /// S at `p` alone: [`Layout::eval`]'s position without the derivatives, for callers that
+    /// need many points and no normals (a third of the work).
+    pub fn position(&self, control: &[Point3], p: ChartPoint) -> Point3 {
+        let p1 = self.settings.degree + 1;
+        let (mut sum, mut total) = (Vector3::zeros(), 0.0);
+        for (rep, _) in self.atlas.locate_with_transitions(p) {
+            let chart = &self.atlas.charts()[rep.chart.index()];
+            let w = rep.coords;
+            let blend = self.raw_blend(chart.domain(), w).val;
+            let (fu, nu) = self.basis.eval(w.re, 0);
+            let (fv, nv) = self.basis.eval(w.im, 0);
+            let mut patch = Vector3::zeros();
+            for (j, y) in nv[0][..p1].iter().enumerate() {
+                for (i, x) in nu[0][..p1].iter().enumerate() {
+                    let c = self.control_index(rep.chart, fu + i, fv + j);
+                    patch += control[c].coords * (x * y);
+                }
+            }
+            sum += patch * blend;
+            total += blend;
+        }
+        // Σ b_c E_c / Σ b_c: an affine combination, accumulated from the origin.
+        Point3::from(sum / total)
+    }
+
     /// S and its first and second derivatives at `p`, in `p.chart`'s coordinates.
     pub fn eval(&self, control: &[Point3], p: ChartPoint) -> SurfaceJet {
         let mut weights = Vec::with_capacity(64);

@@ -568,6 +568,8 @@ proptest! {
             prop_assert_eq!(s.index, i);
             let direct = surface.eval(points[i]);
             prop_assert!((s.position - direct.pos).norm() <= 1e-12);
+            // The position-only path (the remesher's chordal tests) is the same point.
+            prop_assert!((surface.position(points[i]) - direct.pos).norm() <= 1e-12);
             prop_assert!((s.du - direct.du).norm() <= 1e-9 * (1.0 + direct.du.norm()));
             let cross = s.du.cross(&s.dv);
             prop_assert!((cross - direct.du.cross(&direct.dv)).norm() <= 1e-9 * (1.0 + cross.norm()));
