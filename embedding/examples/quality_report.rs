@@ -2,7 +2,8 @@
 //! t_e = t_r = 32 tessellation, triangle angles, the largest bend between neighbours, triangles
 //! facing away from the surface, and the chordal error.
 //! `cargo run --release -p embedding --example quality_report [GENERA…]`; `NTORI_ROUNDS=R` sets
-//! the rounds, `NTORI_WHERE=1` lists the triangles that miss the targets.
+//! the rounds, `NTORI_TOLERANCE=T` the tolerance, `NTORI_WHERE=1` lists the triangles that miss
+//! the targets.
 use std::time::Instant;
 
 use embedding::remesh::{QualitySettings, quality_mesh};
@@ -31,6 +32,9 @@ fn main() {
     let mut settings = QualitySettings::default();
     if let Ok(r) = std::env::var("NTORI_ROUNDS") {
         settings.rounds = r.parse().expect("NTORI_ROUNDS: a number of rounds");
+    }
+    if let Ok(t) = std::env::var("NTORI_TOLERANCE") {
+        settings.tolerance = t.parse().expect("NTORI_TOLERANCE: a fraction of the diagonal");
     }
     println!(
         "genus  triangles  time(s)  t32-triangles  t32-time(s)  angles(°)      ≥20°(%)  ≥150°  bend(°)  away  chordal/diag"

@@ -52,6 +52,19 @@ pub const MAX_BEND: f64 = 18.0;
 /// settle a round).
 const MAX_PASSES: usize = 12;
 
+/// The angle (radians) a triangle should not reach: a cap, whose other two angles are under 30°.
+const CAP_ANGLE: f64 = 150.0 * std::f64::consts::PI / 180.0;
+
+/// How far under [`CAP_ANGLE`] a triangle's largest angle already counts as a cap to remove.
+const UNCAP_MARGIN: f64 = 10.0 * std::f64::consts::PI / 180.0;
+
+/// The smallest angle (radians) an uncapping flip may leave, where half the old one is smaller.
+const UNCAP_FLOOR: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
+/// A smoothing step shorter than this fraction of the target length does not count as a change
+/// (the next round does not look at the vertex again for it).
+const MOVE_NOTICED: f64 = 0.1;
+
 /// The most passes of collapses or valence flips in one round (their last passes change a few
 /// edges each, back and forth).
 const POLISH_PASSES: usize = 3;
@@ -228,13 +241,17 @@ pub fn quality_mesh(
     r.repeat(|r| r.collapse_short());
     r.repeat_at_most(POLISH_PASSES, |r| r.flip(FlipRule::Valence));
     r.smooth(2);
+    // After the first round, a round looks only where the round before changed something.
+    let mut since = 0;
     for _ in 0..settings.rounds {
+        let round = r.pass + 1;
         r.grade_sizes();
-        r.repeat(|r| r.split_long());
+        r.repeat_from(since, MAX_PASSES, |r| r.split_long());
         // Collapses and valence flips polish: the next round picks up what a few passes leave.
-        r.repeat_at_most(POLISH_PASSES, |r| r.collapse_short());
-        r.repeat_at_most(POLISH_PASSES, |r| r.flip(FlipRule::Valence));
+        r.repeat_from(since, POLISH_PASSES, |r| r.collapse_short());
+        r.repeat_from(since, POLISH_PASSES, |r| r.flip(FlipRule::Valence));
         r.smooth(1);
+        since = round;
     }
     // Refine what is still turned away or bent, let the shapes settle, then make sure of the
     // tolerance.
@@ -287,8 +304,14 @@ enum FlipRule {
     Valence,
     /// Where the two angles facing the edge sum to more than π (and the chordal error stays).
     Delaunay,
-    /// Where the pair's smallest angle grows (and the chordal error stays).
+    /// Where the pair's smallest angle grows and no angle reaches [`CAP_ANGLE`] that had not
+    /// (and the chordal error stays).
     Mend,
+    /// Where the pair's largest angle shrinks and the smallest stays above half of what it was
+    /// or 5° (and the chordal error stays): a cap's long edge, where the quad across it is too
+    /// thin for the smallest angle to grow. A large angle is the worse defect (Babuška and Aziz's
+    /// maximum angle condition: interpolated gradients stay bounded as long as it holds).
+    Uncap,
 }
 
 impl Remesher<'_> {
@@ -474,9 +497,11 @@ impl Remesher<'_> {
                     let (sa, sb) = (self.verts[a].size, self.verts[b].size);
                     if sa > sb + GRADATION * d {
                         self.verts[a].size = sb + GRADATION * d;
+                        self.touch(a as u32);
                         changed = true;
                     } else if sb > sa + GRADATION * d {
                         self.verts[b].size = sa + GRADATION * d;
+                        self.touch(b as u32);
                         changed = true;
                     }
                 }
@@ -524,8 +549,14 @@ impl Remesher<'_> {
     /// changed (every test an operation makes depends on its edge's two triangles and their
     /// corners' rings, so elsewhere the answer would be the same as before). Late passes change
     /// a few dozen edges of tens of thousands.
-    fn repeat_at_most(&mut self, passes: usize, mut pass: impl FnMut(&mut Self) -> usize) {
-        self.since = 0;
+    fn repeat_at_most(&mut self, passes: usize, pass: impl FnMut(&mut Self) -> usize) {
+        self.repeat_from(0, passes, pass);
+    }
+
+    /// [`Remesher::repeat_at_most`] whose first pass looks only at what changed from pass
+    /// `since` on.
+    fn repeat_from(&mut self, since: u32, passes: usize, mut pass: impl FnMut(&mut Self) -> usize) {
+        self.since = since;
         for _ in 0..passes {
             self.pass += 1;
             let started = self.pass;
@@ -691,6 +722,14 @@ impl Remesher<'_> {
                 count += 1;
                 continue;
             }
+            // A cap that no flip mends: trade it for a pair with a smaller largest angle.
+            let (a, b) = sides[0];
+            if self.largest_angle(&[t]) >= CAP_ANGLE - UNCAP_MARGIN
+                && self.try_flip(a, b, FlipRule::Uncap)
+            {
+                count += 1;
+                continue;
+            }
             // A needle's shortest edge, or a cap's, collapsed.
             let (a, b) = sides[2];
             if self.collapse(a, b, true) || self.collapse(b, a, true) {
@@ -704,11 +743,6 @@ impl Remesher<'_> {
     /// tilts from its corners' normals more than the old ones did (or half of [`MAX_BEND`]), and
     /// each is within the chordal tolerance.
     fn mends(&self, old: &[[u32; 3]], new: &[[u32; 3]]) -> bool {
-        let least = |ts: &[[u32; 3]]| {
-            ts.iter()
-                .map(|&t| self.smallest_angle(t))
-                .fold(f64::INFINITY, f64::min)
-        };
         let tilt = |ts: &[[u32; 3]]| {
             ts.iter()
                 .map(|&t| {
@@ -720,17 +754,35 @@ impl Remesher<'_> {
                 })
                 .fold(0.0, f64::max)
         };
-        least(new) > least(old) + 1e-9
+        self.least_angle(new) > self.least_angle(old) + 1e-9
+            && self.largest_angle(new) < CAP_ANGLE.max(self.largest_angle(old))
             && tilt(new) <= tilt(old).max(0.5 * MAX_BEND.to_radians())
             && new.iter().all(|&t| self.chordal_error(t) <= self.tolerance)
     }
 
+    /// The triangle's three angles (radians).
+    fn angles(&self, t: [u32; 3]) -> [f64; 3] {
+        let p = t.map(|i| self.pos(i));
+        [0, 1, 2].map(|k| (p[(k + 1) % 3] - p[k]).angle(&(p[(k + 2) % 3] - p[k])))
+    }
+
     /// The triangle's smallest angle (radians).
     fn smallest_angle(&self, t: [u32; 3]) -> f64 {
-        let p = t.map(|i| self.pos(i));
-        (0..3)
-            .map(|k| (p[(k + 1) % 3] - p[k]).angle(&(p[(k + 2) % 3] - p[k])))
+        self.angles(t).into_iter().fold(f64::INFINITY, f64::min)
+    }
+
+    /// The smallest angle of these triangles.
+    fn least_angle(&self, ts: &[[u32; 3]]) -> f64 {
+        ts.iter()
+            .map(|&t| self.smallest_angle(t))
             .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The largest angle of these triangles.
+    fn largest_angle(&self, ts: &[[u32; 3]]) -> f64 {
+        ts.iter()
+            .flat_map(|&t| self.angles(t))
+            .fold(0.0, f64::max)
     }
 
     /// Splits the longest edge of every triangle whose chordal error exceeds the tolerance.
@@ -964,9 +1016,14 @@ impl Remesher<'_> {
                 angle(c, a, b) + angle(d, b, a) > std::f64::consts::PI + 1e-9
             }
             FlipRule::Mend => {
-                let least =
-                    |x: [u32; 3], y: [u32; 3]| self.smallest_angle(x).min(self.smallest_angle(y));
-                least([a, d, c], [d, b, c]) > least([a, b, c], [b, a, d]) + 1e-9
+                let (old, new) = ([[a, b, c], [b, a, d]], [[a, d, c], [d, b, c]]);
+                self.least_angle(&new) > self.least_angle(&old) + 1e-9
+                    && self.largest_angle(&new) < CAP_ANGLE.max(self.largest_angle(&old))
+            }
+            FlipRule::Uncap => {
+                let (old, new) = ([[a, b, c], [b, a, d]], [[a, d, c], [d, b, c]]);
+                self.largest_angle(&new) < self.largest_angle(&old) - 1e-9
+                    && self.least_angle(&new) >= (0.5 * self.least_angle(&old)).min(UNCAP_FLOOR)
             }
         };
         if !wanted {
@@ -1062,10 +1119,14 @@ impl Remesher<'_> {
     fn move_vertex(&mut self, v: u32, moved: Vertex) {
         let around = |r: &Self| r.folds(r.ring(v).iter().map(|&t| r.tris[t as usize]));
         let old_folds = around(self);
+        let step = (moved.pos - self.pos(v)).norm();
+        let noticed = step > MOVE_NOTICED * moved.size || moved.size != self.verts[v as usize].size;
         let saved = std::mem::replace(&mut self.verts[v as usize], moved);
         let new_folds = around(self);
         if new_folds.no_worse_than(old_folds) {
-            self.touch(v);
+            if noticed {
+                self.touch(v);
+            }
         } else {
             self.verts[v as usize] = saved;
         }

@@ -105,6 +105,18 @@ impl Jet {
         }
     }
 
+    /// c·self.
+    fn scaled(self, c: f64) -> Jet {
+        Jet {
+            val: c * self.val,
+            du: c * self.du,
+            dv: c * self.dv,
+            duu: c * self.duu,
+            duv: c * self.duv,
+            dvv: c * self.dvv,
+        }
+    }
+
     /// a / b by the quotient rule.
     fn quotient(a: Jet, b: Jet) -> Jet {
         let q = a.val / b.val;
@@ -359,28 +371,50 @@ impl<'a> Layout<'a> {
     }
 
     /// S and its first and second derivatives at `p`, in `p.chart`'s coordinates.
+    ///
+    /// The same sum as [`Layout::weights`] gives, grouped by chart: each patch E_c is summed
+    /// with its basis functions' jets first, and the blend, the chain rule and the quotient act on
+    /// the patch (three coordinate jets) rather than on each of its (degree + 1)² weights.
     pub fn eval(&self, control: &[Point3], p: ChartPoint) -> SurfaceJet {
-        let mut weights = Vec::with_capacity(64);
-        self.weights(p, &mut weights);
-        let mut s = SurfaceJet {
-            pos: Point3::origin(),
-            du: Vector3::zeros(),
-            dv: Vector3::zeros(),
-            duu: Vector3::zeros(),
-            duv: Vector3::zeros(),
-            dvv: Vector3::zeros(),
-        };
-        // The weights sum to one (an affine combination), so the position accumulates from the origin.
-        for w in &weights {
-            let c = control[w.control as usize].coords;
-            s.pos.coords += c * w.jet.val;
-            s.du += c * w.jet.du;
-            s.dv += c * w.jet.dv;
-            s.duu += c * w.jet.duu;
-            s.duv += c * w.jet.duv;
-            s.dvv += c * w.jet.dvv;
+        let p1 = self.settings.degree + 1;
+        let mut numerator = [Jet::default(); 3];
+        let mut denominator = Jet::default();
+        for (rep, psi) in self.atlas.locate_with_transitions(p) {
+            let chart = &self.atlas.charts()[rep.chart.index()];
+            let w = rep.coords;
+            let (d1, d2) = derivatives(&psi, p.coords);
+            let raw = self.raw_blend(chart.domain(), w);
+            add(&mut denominator, raw.through(d1, d2));
+            let (fu, nu) = self.basis.eval(w.re, 2);
+            let (fv, nv) = self.basis.eval(w.im, 2);
+            // E_c and its derivatives in its own chart's coordinates, one jet per coordinate.
+            let mut patch = [Jet::default(); 3];
+            for j in 0..p1 {
+                for i in 0..p1 {
+                    let basis = Jet::tensor(
+                        [nu[0][i], nu[1][i], nu[2][i]],
+                        [nv[0][j], nv[1][j], nv[2][j]],
+                    );
+                    let c = control[self.control_index(rep.chart, fu + i, fv + j)];
+                    for (k, e) in patch.iter_mut().enumerate() {
+                        add(e, basis.scaled(c[k]));
+                    }
+                }
+            }
+            for (n, e) in numerator.iter_mut().zip(patch) {
+                add(n, Jet::product(raw, e).through(d1, d2));
+            }
         }
-        s
+        let [x, y, z] = numerator.map(|n| Jet::quotient(n, denominator));
+        let v = |f: fn(&Jet) -> f64| Vector3::new(f(&x), f(&y), f(&z));
+        SurfaceJet {
+            pos: Point3::from(v(|j| j.val)),
+            du: v(|j| j.du),
+            dv: v(|j| j.dv),
+            duu: v(|j| j.duu),
+            duv: v(|j| j.duv),
+            dvv: v(|j| j.dvv),
+        }
     }
 }
 
