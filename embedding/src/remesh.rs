@@ -88,7 +88,7 @@ impl Default for QualitySettings {
             tolerance: 1e-3,
             bend: 0.22,
             max_edge: 0.05,
-            rounds: 5,
+            rounds: 3,
         }
     }
 }

@@ -73,9 +73,16 @@ fn every_format_exports_through_the_binary() {
             String::from_utf8_lossy(&bytes[..16])
         );
         let stdout = String::from_utf8_lossy(&assert.get_output().stdout).into_owned();
-        // t_e = t_r = 16 by default: 4n·16² + 8n·16·31 triangles at genus 2.
+        // The quality tessellation by default; --te/--tr choose t_e/t_r (4n·t_e² +
+        // 8n·t_e·(2t_r − 1) triangles at genus n).
         if extra.is_empty() {
-            assert!(stdout.contains("9984 triangles"), "{stdout}");
+            assert!(
+                stdout.contains("quality tessellation to 0.001 of the diagonal"),
+                "{stdout}"
+            );
+        } else if extra[0] == "--te" {
+            assert!(stdout.contains("t_e = 4, t_r = 8"), "{stdout}");
+            assert!(stdout.contains(" 1088 triangles"), "{stdout}");
         }
     }
     // --format overrides the extension; -q prints nothing.
@@ -583,4 +590,14 @@ fn tolerance_exports_the_quality_tessellation() {
             .stderr(predicate::str::contains(says));
     }
     assert!(!dir.path().join("bad.obj").exists());
+    // --te alone picks t_e/t_r, with t_r at 16.
+    ntori()
+        .arg("export")
+        .arg(&model)
+        .arg("-o")
+        .arg(dir.path().join("te.off"))
+        .args(["--te", "4"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("t_e = 4, t_r = 16"));
 }

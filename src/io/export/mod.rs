@@ -323,6 +323,15 @@ pub enum Meshing {
     Quality { tolerance: f64 },
 }
 
+impl Default for Meshing {
+    /// The quality tessellation at [`QualitySettings`]' default tolerance (0.001 of the diagonal).
+    fn default() -> Meshing {
+        Meshing::Quality {
+            tolerance: QualitySettings::default().tolerance,
+        }
+    }
+}
+
 impl From<(u32, u32)> for Meshing {
     fn from((te, tr): (u32, u32)) -> Meshing {
         Meshing::TeTr { te, tr }
