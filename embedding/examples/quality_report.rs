@@ -3,10 +3,10 @@
 //! facing away from the surface, and the chordal error.
 //! `cargo run --release -p embedding --example quality_report [GENERA…]`; `NTORI_ROUNDS=R` sets
 //! the rounds, `NTORI_TOLERANCE=T` the tolerance, `NTORI_WHERE=1` lists the triangles that miss
-//! the targets.
+//! the targets, `NTORI_QUADS=1` reports the all-quad tessellation instead (its corner angles).
 use std::time::Instant;
 
-use embedding::remesh::{QualitySettings, quality_mesh};
+use embedding::remesh::{QualitySettings, quad_mesh, quality_mesh};
 use embedding::{Model, Point3, Stencil, Surface};
 
 fn asset(genus: u32) -> Option<Surface> {
@@ -34,7 +34,9 @@ fn main() {
         settings.rounds = r.parse().expect("NTORI_ROUNDS: a number of rounds");
     }
     if let Ok(t) = std::env::var("NTORI_TOLERANCE") {
-        settings.tolerance = t.parse().expect("NTORI_TOLERANCE: a fraction of the diagonal");
+        settings.tolerance = t
+            .parse()
+            .expect("NTORI_TOLERANCE: a fraction of the diagonal");
     }
     println!(
         "genus  triangles  time(s)  t32-triangles  t32-time(s)  angles(°)      ≥20°(%)  ≥150°  bend(°)  away  chordal/diag"
@@ -42,7 +44,12 @@ fn main() {
     for genus in genera {
         let Some(s) = asset(genus) else { continue };
         let start = Instant::now();
-        let q = quality_mesh(&s, &settings).expect("a quality mesh");
+        let quads = std::env::var("NTORI_QUADS").is_ok();
+        let q = if quads {
+            quad_mesh(&s, &settings).expect("a quad mesh")
+        } else {
+            quality_mesh(&s, &settings).expect("a quality mesh")
+        };
         let seconds = start.elapsed().as_secs_f64();
         if std::env::var("NTORI_WHERE").is_ok() {
             report_bad(&s, &q);
@@ -67,6 +74,9 @@ fn main() {
             2 - 2 * genus as i64,
             "genus {genus}"
         );
+        if quads {
+            report_quads(genus, seconds, &q);
+        }
         let shape = mesh::mesh_shape(&pos, &q.triangles).expect("a mesh");
         let fidelity = q.fidelity(&s);
         let (worst, away) = (fidelity.chordal_error, fidelity.facing_away);
@@ -139,4 +149,34 @@ pub fn report_bad(s: &Surface, q: &embedding::remesh::QualityMesh) {
             );
         }
     }
+}
+
+/// Quad count, corner angles (smallest, largest, share within 45°–135°) and the largest bend
+/// between a quad's two halves.
+fn report_quads(genus: u32, seconds: f64, q: &embedding::remesh::QualityMesh) {
+    let faces = q.quad_faces();
+    let (mut least, mut most, mut fine) = (f64::INFINITY, 0.0f64, 0usize);
+    for f in &faces {
+        let p = f.map(|i| q.positions[i as usize]);
+        let angles: Vec<f64> = (0..4)
+            .map(|k| {
+                (p[(k + 3) % 4] - p[k])
+                    .angle(&(p[(k + 1) % 4] - p[k]))
+                    .to_degrees()
+            })
+            .collect();
+        let (lo, hi) = angles
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(l, h), &a| (l.min(a), h.max(a)));
+        least = least.min(lo);
+        most = most.max(hi);
+        if lo >= 45.0 && hi <= 135.0 {
+            fine += 1;
+        }
+    }
+    println!(
+        "genus {genus}: {} quads in {seconds:.2} s, corner angles {least:.1}°–{most:.1}°, {:.2}% within 45°–135°",
+        faces.len(),
+        100.0 * fine as f64 / faces.len() as f64
+    );
 }

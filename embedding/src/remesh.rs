@@ -12,7 +12,12 @@
 //!    its triangles, within the tangent plane;
 //! 3. split edges until every triangle's chordal error (the distance between the flat triangle's
 //!    centre and the surface point at its corners' mean chart coordinates) is within the
-//!    tolerance, then flip edges that are not locally Delaunay where that keeps the error.
+//!    tolerance, then flip edges that are not locally Delaunay where that keeps the error;
+//! 4. mend what is left under 20° or over 150° by flips and collapses that keep the error.
+//!
+//! Passes are incremental: after a pass over the whole mesh, the next looks only at the triangles
+//! around vertices the one before changed. The surface evaluations of a pass (midpoints, chordal
+//! tests, smoothing targets) are made first, on all cores; the topology changes then run in order.
 //!
 //! Every vertex stays a chart point, kept in its deepest chart: midpoints are taken in a chart
 //! holding both ends, and a vertex moves in chart coordinates (the tangent-plane step pulled back
@@ -36,7 +41,10 @@ use rayon::prelude::*;
 
 use crate::{EmbeddingError, Point3, Surface, Vector3};
 
+mod quads;
 mod start;
+
+pub use quads::{TOLERANCE_FACTOR as QUAD_TOLERANCE_FACTOR, quad_mesh, quad_of};
 
 /// How fast the target edge length may grow from one vertex to its neighbour, per unit distance.
 pub const GRADATION: f64 = 0.35;
@@ -44,8 +52,8 @@ pub const GRADATION: f64 = 0.35;
 /// The t_e of the tessellation whose squares the remesher starts from.
 pub const START_RESOLUTION: u32 = 8;
 
-/// The largest angle (degrees) between neighbouring triangles' normals the remesher leaves: edges
-/// bending more are split.
+/// The largest angle (degrees) between neighbouring triangles' normals the remesher leaves by
+/// default ([`QualitySettings::max_bend`]).
 pub const MAX_BEND: f64 = 18.0;
 
 /// The most passes of one operation in a row (each pass changes every edge it can; a handful
@@ -78,6 +86,9 @@ pub struct QualitySettings {
     pub bend: f64,
     /// Longest edge, as a fraction of the diagonal.
     pub max_edge: f64,
+    /// The largest angle (degrees) between neighbouring triangles' normals: edges bending more
+    /// are split.
+    pub max_bend: f64,
     /// Rounds of split, collapse, flip and smooth.
     pub rounds: usize,
 }
@@ -88,6 +99,7 @@ impl Default for QualitySettings {
             tolerance: 1e-3,
             bend: 0.22,
             max_edge: 0.05,
+            max_bend: MAX_BEND,
             rounds: 3,
         }
     }
@@ -122,6 +134,9 @@ pub struct QualityMesh {
     pub triangle_charts: Vec<ChartId>,
     /// Each triangle's corners in its home chart's coordinates.
     pub triangle_coords: Vec<[Complex64; 3]>,
+    /// Whether the triangles are halves of quads ([`quad_mesh`]): triangles 2k = (a, b, c) and
+    /// 2k + 1 = (a, c, d) make quad k = (a, b, c, d), in one chart.
+    pub quads: bool,
 }
 
 /// How closely a [`QualityMesh`] follows its surface, measured at each triangle's centre.
@@ -135,6 +150,17 @@ pub struct Fidelity {
 }
 
 impl QualityMesh {
+    /// The quads, where the triangles are their halves ([`QualityMesh::quads`]); none otherwise.
+    pub fn quad_faces(&self) -> Vec<[u32; 4]> {
+        if !self.quads {
+            return Vec::new();
+        }
+        self.triangles
+            .chunks_exact(2)
+            .filter_map(|p| quad_of(p[0], p[1]))
+            .collect()
+    }
+
     /// Measures the mesh against the exact surface (not through the remesher's own bookkeeping).
     pub fn fidelity(&self, surface: &Surface) -> Fidelity {
         let diagonal = crate::fit::diagonal(&self.positions);
@@ -186,6 +212,8 @@ struct Remesher<'a> {
     /// Absolute tolerance and edge-length bounds.
     tolerance: f64,
     bend: f64,
+    /// Radians.
+    max_bend: f64,
     max_edge: f64,
     min_edge: f64,
     verts: Vec<Vertex>,
@@ -221,6 +249,7 @@ pub fn quality_mesh(
         surface,
         tolerance: settings.tolerance * diagonal,
         bend: settings.bend,
+        max_bend: settings.max_bend.to_radians(),
         max_edge: settings.max_edge * diagonal,
         min_edge: 1e-4 * diagonal,
         verts: Vec::with_capacity(start.vertices.len()),
@@ -673,9 +702,10 @@ impl Remesher<'_> {
         self.split_edges(long.into_iter().map(|(_, a, b)| (a, b)).collect(), true)
     }
 
-    /// Splits every edge across which the triangles' normals turn by more than [`MAX_BEND`].
+    /// Splits every edge across which the triangles' normals turn by more than the settings'
+    /// `max_bend`.
     fn split_bent(&mut self) -> usize {
-        let limit = MAX_BEND.to_radians().cos();
+        let limit = self.max_bend.cos();
         let normal = |t: u32| {
             let p = self.tris[t as usize].map(|i| self.pos(i));
             (p[1] - p[0]).cross(&(p[2] - p[0])).normalize()
@@ -740,7 +770,7 @@ impl Remesher<'_> {
     }
 
     /// Whether triangles `new` may replace `old`: their smallest angle is larger, no triangle
-    /// tilts from its corners' normals more than the old ones did (or half of [`MAX_BEND`]), and
+    /// tilts from its corners' normals more than the old ones did (or half the largest bend), and
     /// each is within the chordal tolerance.
     fn mends(&self, old: &[[u32; 3]], new: &[[u32; 3]]) -> bool {
         let tilt = |ts: &[[u32; 3]]| {
@@ -756,7 +786,7 @@ impl Remesher<'_> {
         };
         self.least_angle(new) > self.least_angle(old) + 1e-9
             && self.largest_angle(new) < CAP_ANGLE.max(self.largest_angle(old))
-            && tilt(new) <= tilt(old).max(0.5 * MAX_BEND.to_radians())
+            && tilt(new) <= tilt(old).max(0.5 * self.max_bend)
             && new.iter().all(|&t| self.chordal_error(t) <= self.tolerance)
     }
 
@@ -780,9 +810,7 @@ impl Remesher<'_> {
 
     /// The largest angle of these triangles.
     fn largest_angle(&self, ts: &[[u32; 3]]) -> f64 {
-        ts.iter()
-            .flat_map(|&t| self.angles(t))
-            .fold(0.0, f64::max)
+        ts.iter().flat_map(|&t| self.angles(t)).fold(0.0, f64::max)
     }
 
     /// Splits the longest edge of every triangle whose chordal error exceeds the tolerance.
@@ -839,7 +867,10 @@ impl Remesher<'_> {
     /// midpoints, the pass's surface evaluations, are found first on all cores (a split moves no
     /// vertex, so they stay right).
     fn split_edges(&mut self, edges: Vec<(u32, u32)>, sizing: bool) -> usize {
-        let mids: Vec<Option<Vertex>> = edges.par_iter().map(|&(a, b)| self.centre([a, b])).collect();
+        let mids: Vec<Option<Vertex>> = edges
+            .par_iter()
+            .map(|&(a, b)| self.centre([a, b]))
+            .collect();
         edges
             .into_iter()
             .zip(mids)

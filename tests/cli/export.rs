@@ -590,6 +590,49 @@ fn tolerance_exports_the_quality_tessellation() {
             .stderr(predicate::str::contains(says));
     }
     assert!(!dir.path().join("bad.obj").exists());
+    // --quads: all quads, in the formats with polygons only.
+    let quads = dir.path().join("q.off");
+    ntori()
+        .arg("export")
+        .arg(&model)
+        .arg("-o")
+        .arg(&quads)
+        .args(["--quads", "--tolerance", "0.002"])
+        .assert()
+        .success()
+        .stdout(
+            predicate::str::contains("quad tessellation to 0.002 of the diagonal")
+                .and(predicate::str::contains(" quads, ")),
+        );
+    let text = std::fs::read_to_string(&quads).unwrap();
+    let counts: Vec<usize> = text
+        .lines()
+        .find(|l| !l.starts_with('#') && !l.starts_with("OFF"))
+        .unwrap()
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("4 ")).count(),
+        counts[1]
+    );
+    for bad in [&["--quads", "--te", "8"][..], &["--quads"][..]] {
+        let out = dir.path().join("bad.stl");
+        ntori()
+            .arg("export")
+            .arg(&model)
+            .arg("-o")
+            .arg(&out)
+            .args(bad)
+            .assert()
+            .failure()
+            .stderr(predicate::str::contains(if bad.len() > 1 {
+                "cannot be used with"
+            } else {
+                "STL stores triangles only; --quads applies to OBJ, PLY and OFF"
+            }));
+        assert!(!out.exists());
+    }
     // --te alone picks t_e/t_r, with t_r at 16.
     ntori()
         .arg("export")

@@ -1191,3 +1191,102 @@ fn the_atlas_reads_back_split_and_the_chart_mode_whole() {
     assert!(topology.closed && topology.manifold);
     assert_eq!(topology.euler_characteristic, -2);
 }
+
+/// `Meshing::Quads` writes quads to OBJ, PLY and OFF, read back as quads by tobj (not
+/// triangulating), ply-rs-bw's parser and the OFF parser here: a closed, manifold polygon mesh of
+/// the right χ whose quads face outward; the formats without polygons refuse it.
+#[test]
+fn quads_read_back_as_quads_and_only_where_a_format_has_polygons() {
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::{DefaultElement, Property};
+
+    for genus in [0, 2, 3] {
+        let surface = crate::common::small_model(genus);
+        let mesh = export::quad_surface_mesh(surface, 0.002, UvLayout::Chart).unwrap();
+        assert!(mesh.quads);
+        let quads = mesh.quad_faces();
+        assert_eq!(2 * quads.len(), mesh.triangles.len());
+        assert_eq!(mesh.face_count(), format!("{} quads", quads.len()));
+        let check_quads = |faces: &[Vec<u32>], positions: usize, what: &str| {
+            assert_eq!(faces.len(), quads.len(), "{what}");
+            assert!(faces.iter().all(|f| f.len() == 4), "{what}");
+            let topology = HalfEdgeMesh::from_polygons(positions, faces.iter().map(|f| &f[..]))
+                .unwrap()
+                .topology();
+            assert!(
+                topology.closed && topology.manifold && topology.orientable,
+                "{what}"
+            );
+            assert_eq!(
+                topology.euler_characteristic,
+                2 - 2 * genus as i64,
+                "{what}"
+            );
+        };
+        // Each quad faces the way its corners' normals do (its diagonals' cross product).
+        for f in &quads {
+            let p = f.map(|i| mesh.positions[i as usize]);
+            let n = (p[2] - p[0]).cross(&(p[3] - p[1]));
+            let m: Vector3 = f.iter().map(|&i| mesh.normals[i as usize]).sum();
+            assert!(n.dot(&m) > 0.0, "genus {genus}: a quad faces inward");
+        }
+        // OBJ through tobj, faces kept as written.
+        let bytes = write(&mesh, Format::Obj, Encoding::Binary);
+        let options = tobj::LoadOptions {
+            single_index: true,
+            triangulate: false,
+            ..Default::default()
+        };
+        let (models, _) =
+            tobj::load_obj_buf(&mut Cursor::new(&bytes), &options, |_| unreachable!()).unwrap();
+        let m = &models[0].mesh;
+        assert!(m.face_arities.iter().all(|&a| a == 4), "OBJ genus {genus}");
+        let faces: Vec<Vec<u32>> = m.indices.chunks(4).map(<[u32]>::to_vec).collect();
+        check_quads(&faces, m.positions.len() / 3, &format!("OBJ genus {genus}"));
+        // PLY through its parser.
+        let bytes = write(&mesh, Format::Ply, Encoding::Binary);
+        let ply = Parser::<DefaultElement>::new()
+            .read_ply(&mut Cursor::new(&bytes))
+            .unwrap();
+        let faces: Vec<Vec<u32>> = ply.payload["face"]
+            .iter()
+            .map(|e| match e.get("vertex_indices") {
+                Some(Property::ListInt(l)) => l.iter().map(|&i| i as u32).collect(),
+                other => panic!("PLY genus {genus}: face is {other:?}"),
+            })
+            .collect();
+        check_quads(
+            &faces,
+            ply.payload["vertex"].len(),
+            &format!("PLY genus {genus}"),
+        );
+        assert_eq!(faces, quads.iter().map(|q| q.to_vec()).collect::<Vec<_>>());
+        // OFF: "4 a b c d" lines.
+        let bytes = write(&mesh, Format::Off, Encoding::Binary);
+        let text = String::from_utf8(bytes).unwrap();
+        let faces: Vec<Vec<u32>> = text
+            .lines()
+            .filter(|l| l.starts_with("4 "))
+            .map(|l| {
+                l.split_whitespace()
+                    .skip(1)
+                    .map(|x| x.parse().unwrap())
+                    .collect()
+            })
+            .collect();
+        check_quads(&faces, mesh.positions.len(), &format!("OFF genus {genus}"));
+        for format in [Format::Stl, Format::Glb, Format::ThreeMf] {
+            let err = export::write_to(
+                &mesh,
+                format,
+                &ExportOptions::default(),
+                &mut Cursor::new(Vec::new()),
+            )
+            .unwrap_err();
+            assert!(
+                matches!(err, ExportError::NoQuads(f) if f == format),
+                "{err}"
+            );
+        }
+    }
+}

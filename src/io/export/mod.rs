@@ -69,6 +69,8 @@ pub enum MeshSource {
     /// The quality tessellation ([`quality_surface_mesh`]) at this chordal tolerance, a fraction
     /// of the surface's diagonal.
     Quality { tolerance: f64 },
+    /// The all-quad tessellation ([`quad_surface_mesh`]) at this chordal tolerance.
+    Quads { tolerance: f64 },
     /// The mesh a fit targets ([`input_mesh`]).
     FitInput,
     /// Another mesh of chart points ([`evaluate_mesh`]).
@@ -93,6 +95,9 @@ pub struct SurfaceMesh {
     pub charts: Vec<u32>,
     /// Counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
+    /// Whether the triangles are halves of quads: triangles 2k and 2k + 1 share an edge, the
+    /// quad's diagonal ([`SurfaceMesh::quad_faces`]). Formats with polygons write the quads.
+    pub quads: bool,
 }
 
 /// A triangle mesh of the surface whose vertices are chart points, borrowed: what
@@ -184,6 +189,11 @@ impl Format {
             })
     }
 
+    /// Whether the format stores polygons (quads) as well as triangles.
+    pub fn has_quads(self) -> bool {
+        matches!(self, Format::Obj | Format::Ply | Format::Off)
+    }
+
     /// Whether the format has a text and a binary variant.
     pub fn has_encodings(self) -> bool {
         matches!(self, Format::Ply | Format::Stl)
@@ -238,6 +248,8 @@ pub enum ExportError {
     NoEncodings(Format),
     #[error("{0} stores no texture coordinates; --uv atlas applies to OBJ, PLY and GLB only")]
     NoUvs(Format),
+    #[error("{0} stores triangles only; --quads applies to OBJ, PLY and OFF")]
+    NoQuads(Format),
     #[error("the scale must be a finite number above 0, got {0}")]
     Scale(f64),
     #[error(
@@ -321,6 +333,19 @@ pub enum Meshing {
     /// The quality tessellation ([`quality_surface_mesh`]) to this chordal tolerance, a fraction
     /// of the surface's diagonal.
     Quality { tolerance: f64 },
+    /// The all-quad tessellation ([`quad_surface_mesh`]) to this chordal tolerance, for the
+    /// formats that store polygons ([`Format::has_quads`]).
+    Quads { tolerance: f64 },
+}
+
+impl Meshing {
+    /// Whether `format` can store what this meshing makes.
+    pub fn check(&self, format: Format) -> Result<(), ExportError> {
+        if matches!(self, Meshing::Quads { .. }) && !format.has_quads() {
+            return Err(ExportError::NoQuads(format));
+        }
+        Ok(())
+    }
 }
 
 impl Default for Meshing {
@@ -345,6 +370,9 @@ impl std::fmt::Display for Meshing {
             Meshing::Quality { tolerance } => {
                 write!(f, "quality tessellation to {tolerance} of the diagonal")
             }
+            Meshing::Quads { tolerance } => {
+                write!(f, "quad tessellation to {tolerance} of the diagonal")
+            }
         }
     }
 }
@@ -359,6 +387,7 @@ pub fn mesh_surface(
     match meshing {
         Meshing::TeTr { te, tr } => surface_mesh(surface, (te, tr), uv),
         Meshing::Quality { tolerance } => quality_surface_mesh(surface, tolerance, uv),
+        Meshing::Quads { tolerance } => quad_surface_mesh(surface, tolerance, uv),
     }
 }
 
@@ -378,15 +407,42 @@ pub fn quality_surface_mesh(
         ..QualitySettings::default()
     };
     let q = quality_mesh(surface, &settings)?;
-    let input = ChartMesh {
-        vertices: &q.vertices,
-        triangles: &q.triangles,
-        triangle_charts: &q.triangle_charts,
-        triangle_coords: &q.triangle_coords,
-    };
-    let mut mesh = evaluate_mesh(surface, input, uv)?;
+    let mut mesh = evaluate_mesh(surface, ChartMesh::from(&q), uv)?;
     mesh.source = MeshSource::Quality { tolerance };
     Ok(mesh)
+}
+
+/// The all-quad tessellation of the surface (`embedding::remesh::quad_mesh`: the quality
+/// tessellation's triangles paired and split into quads, chordal error about `tolerance` of the
+/// diagonal), evaluated ([`evaluate_mesh`]); its triangles are the quads' halves.
+pub fn quad_surface_mesh(
+    surface: &Surface,
+    tolerance: f64,
+    uv: UvLayout,
+) -> Result<SurfaceMesh, ExportError> {
+    if surface.is_degenerate() {
+        check_not_degenerate(surface, remesh::start_vertex_count(surface.atlas())? as u64)?;
+    }
+    let settings = QualitySettings {
+        tolerance,
+        ..QualitySettings::default()
+    };
+    let q = remesh::quad_mesh(surface, &settings)?;
+    let mut mesh = evaluate_mesh(surface, ChartMesh::from(&q), uv)?;
+    mesh.source = MeshSource::Quads { tolerance };
+    mesh.quads = true;
+    Ok(mesh)
+}
+
+impl<'a> From<&'a remesh::QualityMesh> for ChartMesh<'a> {
+    fn from(q: &'a remesh::QualityMesh) -> Self {
+        ChartMesh {
+            vertices: &q.vertices,
+            triangles: &q.triangles,
+            triangle_charts: &q.triangle_charts,
+            triangle_coords: &q.triangle_coords,
+        }
+    }
 }
 
 /// A surface whose control points coincide has no surface to export: refused, naming how many
@@ -430,6 +486,7 @@ pub fn evaluate_mesh(
         uvs: Vec::with_capacity(n),
         charts: Vec::with_capacity(n),
         triangles: input.triangles.to_vec(),
+        quads: false,
     };
     evaluate(
         surface,
@@ -485,6 +542,7 @@ pub fn input_mesh(
             .collect(),
         charts: points.iter().map(|p| p.chart.0).collect(),
         triangles: triangles.to_vec(),
+        quads: false,
     };
     // No analytic normals: every vertex takes its triangles' (what repair does for a pinched one).
     mesh.repair_normals()?;
@@ -578,15 +636,40 @@ impl SurfaceMesh {
                 "genus {}, quality tessellation to {tolerance} of the diagonal",
                 self.genus
             ),
+            MeshSource::Quads { tolerance } => format!(
+                "genus {}, quad tessellation to {tolerance} of the diagonal",
+                self.genus
+            ),
             MeshSource::FitInput => format!("the input mesh of a genus-{} fit", self.genus),
             MeshSource::ChartMesh => format!("genus {}", self.genus),
         };
         format!(
-            "ntori {}: {what}, {} vertices, {} triangles",
+            "ntori {}: {what}, {} vertices, {}",
             env!("CARGO_PKG_VERSION"),
             self.positions.len(),
-            self.triangles.len()
+            self.face_count()
         )
+    }
+
+    /// "N triangles", or "N quads" where the triangles are halves of quads.
+    pub fn face_count(&self) -> String {
+        if self.quads {
+            format!("{} quads", self.triangles.len() / 2)
+        } else {
+            format!("{} triangles", self.triangles.len())
+        }
+    }
+
+    /// The quads whose halves the triangles are ([`SurfaceMesh::quads`]), counter-clockwise as
+    /// the triangles wind; none where they are not.
+    pub fn quad_faces(&self) -> Vec<[u32; 4]> {
+        if !self.quads {
+            return Vec::new();
+        }
+        self.triangles
+            .chunks_exact(2)
+            .filter_map(|p| remesh::quad_of(p[0], p[1]))
+            .collect()
     }
 
     /// What the texture coordinates are, for file headers.
@@ -715,6 +798,8 @@ impl SurfaceMesh {
 pub struct Exported {
     pub vertices: usize,
     pub triangles: usize,
+    /// Whether the file holds the triangles paired into quads.
+    pub quads: bool,
     /// Triangles facing against the surface's normals ([`SurfaceMesh::folded_triangles`]): the
     /// tessellation is too coarse for the surface where this is not zero.
     pub folded: usize,
@@ -722,6 +807,17 @@ pub struct Exported {
     pub size: [f64; 3],
     /// The unit the file's numbers are in.
     pub unit: Units,
+}
+
+impl Exported {
+    /// "N triangles", or "N quads" where the file holds quads.
+    pub fn face_count(&self) -> String {
+        if self.quads {
+            format!("{} quads", self.triangles / 2)
+        } else {
+            format!("{} triangles", self.triangles)
+        }
+    }
 }
 
 /// The export behind `ntori export` and the editor's: tessellates and evaluates `surface` as
@@ -734,6 +830,7 @@ pub fn export_surface(
     options: &ExportOptions,
 ) -> Result<Exported, ExportError> {
     options.check(format)?;
+    meshing.check(format)?;
     let mut mesh = mesh_surface(surface, meshing, options.uv)?;
     let info = FileInfo::new(&mesh, format, options);
     // Placed where it lies (no copy: an export may hold 10⁷ vertices).
@@ -742,6 +839,7 @@ pub fn export_surface(
     Ok(Exported {
         vertices: mesh.positions.len(),
         triangles: mesh.triangles.len(),
+        quads: mesh.quads,
         folded: mesh.folded_triangles(),
         size,
         unit: info.unit,
@@ -758,6 +856,9 @@ pub fn write(
     options: &ExportOptions,
 ) -> Result<[f64; 3], ExportError> {
     options.check(format)?;
+    if mesh.quads && !format.has_quads() {
+        return Err(ExportError::NoQuads(format));
+    }
     let placed = mesh.placed(options.up_for(format), options.factor_for(format));
     write_placed_file(&placed, path, format, &FileInfo::new(mesh, format, options))
 }
@@ -786,6 +887,9 @@ pub fn write_to(
     out: &mut dyn WriteSeek,
 ) -> Result<(), ExportError> {
     options.check(format)?;
+    if mesh.quads && !format.has_quads() {
+        return Err(ExportError::NoQuads(format));
+    }
     let placed = mesh.placed(options.up_for(format), options.factor_for(format));
     placed.check_storable(format)?;
     let info = FileInfo::new(mesh, format, options);

@@ -6,7 +6,7 @@ use super::SurfaceMesh;
 use super::options::FileInfo;
 
 /// Wavefront OBJ: one object (`o` and its name), `v`, `vt`, `vn` per vertex (same index), faces
-/// `f a/a/a b/b/b c/c/c`. OBJ has no per-vertex attribute that could carry the chart id.
+/// `f a/a/a b/b/b c/c/c` (or four corners, for quads). OBJ has no per-vertex attribute that could carry the chart id.
 pub fn write_obj(mesh: &SurfaceMesh, info: &FileInfo, out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out, "# {}", mesh.describe())?;
     writeln!(out, "# {}", info.frame())?;
@@ -27,6 +27,13 @@ pub fn write_obj(mesh: &SurfaceMesh, info: &FileInfo, out: &mut dyn Write) -> st
     for i in 0..mesh.normals.len() {
         let [x, y, z] = mesh.normal_f32(i);
         writeln!(out, "vn {x} {y} {z}")?;
+    }
+    if mesh.quads {
+        for q in mesh.quad_faces() {
+            let [a, b, c, d] = q.map(|i| i + 1);
+            writeln!(out, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c} {d}/{d}/{d}")?;
+        }
+        return Ok(());
     }
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|i| i + 1);

@@ -39,8 +39,9 @@ mod records {
         }
     }
 
-    #[derive(Clone, Copy, Debug, Default)]
-    pub struct Face(pub [i32; 3]);
+    /// A triangle's or a quad's corners.
+    #[derive(Clone, Debug, Default)]
+    pub struct Face(pub Vec<i32>);
 
     impl PropertyAccess for Face {
         fn new() -> Self {
@@ -89,7 +90,13 @@ pub fn write_ply(mesh: &SurfaceMesh, info: &FileInfo, out: &mut dyn Write) -> st
         PropertyType::Scalar(ScalarType::UInt),
     ));
     let mut face = ElementDef::new("face".into());
-    face.count = mesh.triangles.len();
+    let corners = |f: &[u32]| records::Face(f.iter().map(|&i| i as i32).collect());
+    let faces: Vec<records::Face> = if mesh.quads {
+        mesh.quad_faces().iter().map(|q| corners(q)).collect()
+    } else {
+        mesh.triangles.iter().map(|t| corners(t)).collect()
+    };
+    face.count = faces.len();
     face.properties.add(PropertyDef::new(
         "vertex_indices".into(),
         PropertyType::List(ScalarType::UChar, ScalarType::Int),
@@ -110,11 +117,6 @@ pub fn write_ply(mesh: &SurfaceMesh, info: &FileInfo, out: &mut dyn Write) -> st
     vertex_writer.write_header(&mut out, &header)?;
     vertex_writer.write_payload_of_element(&mut out, &vertices, &vertex, &header)?;
     drop(vertices);
-    let faces: Vec<records::Face> = mesh
-        .triangles
-        .iter()
-        .map(|t| records::Face(t.map(|i| i as i32)))
-        .collect();
     Writer::<records::Face>::new().write_payload_of_element(&mut out, &faces, &face, &header)?;
     Ok(())
 }
