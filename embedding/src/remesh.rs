@@ -134,8 +134,8 @@ pub struct QualityMesh {
     pub triangle_charts: Vec<ChartId>,
     /// Each triangle's corners in its home chart's coordinates.
     pub triangle_coords: Vec<[Complex64; 3]>,
-    /// Whether the triangles are halves of quads ([`quad_mesh`]): triangles 2k = (a, b, c) and
-    /// 2k + 1 = (a, c, d) make quad k = (a, b, c, d), in one chart.
+    /// Whether the triangles are halves of quads ([`quad_mesh`]): triangles 2k and 2k + 1 share
+    /// an edge, the diagonal of quad k, in one chart ([`quad_of`] puts the quad together).
     pub quads: bool,
 }
 

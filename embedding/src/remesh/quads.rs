@@ -35,7 +35,8 @@ struct Face {
 }
 
 /// The all-quad tessellation at `settings`' tolerance (see the module documentation). Its
-/// triangles come in pairs, `2k` and `2k + 1` halves of quad `k` ([`QualityMesh::quads`]).
+/// triangles come in pairs, `2k` and `2k + 1` halves of quad `k` ([`QualityMesh::quads`],
+/// [`quad_of`]).
 pub fn quad_mesh(
     surface: &Surface,
     settings: &QualitySettings,
@@ -206,8 +207,20 @@ impl Builder<'_> {
         })
     }
 
-    /// Quad (a, b, c, d), counter-clockwise, as triangles (a, b, c) and (a, c, d) of `chart`.
+    /// Quad (a, b, c, d), counter-clockwise, as two triangles of `chart` split along the diagonal
+    /// through its widest corner: a corner near 180° (where a lone triangle's quads meet its long
+    /// side) then opens into both halves instead of flattening one of them.
     fn quad(&mut self, q: [u32; 4], w: [Complex64; 4], chart: ChartId) {
+        let p = q.map(|i| self.out.positions[i as usize]);
+        let angle = |k: usize| (p[(k + 3) % 4] - p[k]).angle(&(p[(k + 1) % 4] - p[k]));
+        let widest = (0..4)
+            .max_by(|&i, &j| angle(i).total_cmp(&angle(j)))
+            .unwrap_or(0);
+        let (q, w) = if widest % 2 == 1 {
+            ([q[1], q[2], q[3], q[0]], [w[1], w[2], w[3], w[0]])
+        } else {
+            (q, w)
+        };
         self.out.triangles.push([q[0], q[1], q[2]]);
         self.out.triangles.push([q[0], q[2], q[3]]);
         self.out.triangle_coords.push([w[0], w[1], w[2]]);
@@ -265,6 +278,18 @@ fn split(
     Ok(b.out)
 }
 
+/// The quad two triangles sharing an edge make, counter-clockwise as they are: the first's
+/// corners from the far end of the shared edge, then the second's apex. `None` where they share
+/// no edge the same way round.
+pub fn quad_of(first: [u32; 3], second: [u32; 3]) -> Option<[u32; 4]> {
+    (0..3).find_map(|k| {
+        let (a, b) = (first[k], first[(k + 1) % 3]);
+        let reversed = (0..3).any(|j| second[j] == b && second[(j + 1) % 3] == a);
+        let apex = second.into_iter().find(|&v| v != a && v != b)?;
+        reversed.then_some([first[(k + 1) % 3], first[(k + 2) % 3], a, apex])
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -295,16 +320,4 @@ mod tests {
             [(0.0, 0.0), (1.0, 0.0), (1.5, 1.0), (0.5, 1.0)].map(|(x, y)| Point3::new(x, y, 0.0));
         assert!((skew(&rhombus).to_degrees() - (90.0 - 63.43494882292201)).abs() < 1e-9);
     }
-}
-
-/// The quad two triangles sharing an edge make, counter-clockwise as they are: the first's
-/// corners from the far end of the shared edge, then the second's apex. `None` where they share
-/// no edge the same way round.
-pub fn quad_of(first: [u32; 3], second: [u32; 3]) -> Option<[u32; 4]> {
-    (0..3).find_map(|k| {
-        let (a, b) = (first[k], first[(k + 1) % 3]);
-        let reversed = (0..3).any(|j| second[j] == b && second[(j + 1) % 3] == a);
-        let apex = second.into_iter().find(|&v| v != a && v != b)?;
-        reversed.then_some([first[(k + 1) % 3], first[(k + 2) % 3], a, apex])
-    })
 }
