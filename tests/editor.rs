@@ -17,6 +17,7 @@ use ntori::editor::pick::cast_all;
 use ntori::editor::recovery::{RECOVERY_FORMAT, Recovery, RecoveryFile};
 use ntori::editor::state::Grab;
 use ntori::editor::{EditorApp, EditorOptions, EditorState};
+use ntori::io::export::Meshing;
 
 /// The default genus-2 model, fitted once for all tests.
 fn model() -> &'static Surface {
@@ -48,7 +49,8 @@ fn harness() -> Harness<'static, EditorApp> {
         model: Some(model().clone()),
         file: None,
         recovery_dir: None,
-        tessellation: (24, 24),
+        // The quality tessellation, the editor's default.
+        meshing: Meshing::default(),
         native_dialogs: Some(false),
         ..EditorOptions::default()
     })
@@ -489,7 +491,7 @@ fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
         model: Some(model().clone()),
         file: None,
         recovery_dir: Some(dir.path().to_owned()),
-        tessellation: (16, 16),
+        meshing: Meshing::TeTr { te: 16, tr: 16 },
         ..EditorOptions::default()
     });
     harness.run();
@@ -649,13 +651,14 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
     );
     assert_eq!(state.control().len(), 6 * 12 * 12);
     // The refitted surface stays close to the old one.
-    let old = EditorState::new(before.clone(), 24, 24).unwrap();
+    let old = EditorState::new(before.clone(), Meshing::default()).unwrap();
     let worst = old
         .mesh()
-        .positions()
+        .tessellation
+        .vertices
         .iter()
-        .zip(state.mesh().positions())
-        .map(|(a, b)| (a - b).norm())
+        .zip(old.mesh().positions())
+        .map(|(&p, a)| (state.surface_point(p) - a).norm())
         .fold(0.0, f64::max);
     assert!(worst < 0.01 * old.size(), "moved by {worst}");
     assert!(state.is_modified());
@@ -670,6 +673,37 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     harness.run();
     assert_eq!(harness.state().state().unwrap().settings().grid, 12);
+}
+
+/// The side panel's tessellation: the quality one by default, t_e/t_r at the press of a radio
+/// button (the mesh the size the scheme makes), and back; Remesh makes the quality one anew.
+#[test]
+fn the_panel_switches_between_the_quality_and_the_t_e_t_r_tessellation() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.meshing(), Meshing::default());
+    let quality_triangles = state.mesh().triangle_count();
+    harness.get_by_label("t_e, t_r").click();
+    harness.run();
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.meshing(), Meshing::TeTr { te: 32, tr: 32 });
+    assert_eq!(
+        state.mesh().triangle_count() as u64,
+        charts::Tessellation::expected_triangles(2, 32, 32)
+    );
+    harness.get_by_label("Quality").click();
+    harness.run();
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.meshing(), Meshing::default());
+    assert_eq!(state.mesh().triangle_count(), quality_triangles);
+    harness.get_by_label("Remesh").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state().unwrap().mesh().triangle_count(),
+        quality_triangles,
+        "the same surface remeshes the same"
+    );
 }
 
 #[test]
@@ -688,12 +722,17 @@ fn a_new_model_of_another_genus_from_the_dialog() {
     assert_eq!(state.genus(), 1, "{:?}", harness.state().messages());
     assert_eq!(state.path(), None);
     assert!(!state.is_modified());
-    // Tessellation at the editor's setting: 4n·e² + 8n·e(2r − 1) triangles.
-    let (te, tr) = state.tessellation();
-    assert_eq!(
-        state.mesh().triangle_count() as u64,
-        charts::Tessellation::expected_triangles(1, te, tr)
-    );
+    // The quality tessellation of the new torus: closed, χ = 0.
+    assert_eq!(state.meshing(), Meshing::default());
+    let triangles = &state.mesh().tessellation.triangles;
+    let topology = mesh::HalfEdgeMesh::from_polygons(
+        state.mesh().vertex_count(),
+        triangles.iter().map(|t| &t[..]),
+    )
+    .unwrap()
+    .topology();
+    assert!(topology.closed && topology.manifold);
+    assert_eq!(topology.euler_characteristic, 0);
 }
 
 #[test]
@@ -739,7 +778,7 @@ fn a_changed_tessellation_keeps_picking_exact() {
         .state_mut()
         .state_mut()
         .unwrap()
-        .set_tessellation(9, 5)
+        .set_meshing(Meshing::TeTr { te: 9, tr: 5 })
         .unwrap();
     harness.run();
     let (k, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);

@@ -13,25 +13,35 @@ use std::process::ExitCode;
 /// export and screenshots are in the menus. Unsaved work is autosaved to
 /// $XDG_STATE_HOME/ntori (or ~/.local/state/ntori) and offered back after a crash.
 ///
+/// The viewport shows the quality tessellation (well-shaped triangles sized by the curvature;
+/// the side panel's Remesh makes it anew for the shape after edits), or t_e/t_r's with --te/--tr.
 /// Needs a display and a GPU (or Mesa's software Vulkan, lavapipe).
 ///
 /// Examples:
 ///   ntori edit                         the default genus-2 model
-///   ntori edit model.json --te 48 --tr 48
+///   ntori edit model.json --tolerance 0.0005
+///   ntori edit model.json --te 48 --tr 48       (the t_e/t_r tessellation)
 #[derive(clap::Args, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
     /// The model file to open.
     #[arg(value_name = "MODEL")]
     model: Option<PathBuf>,
-    /// Divisions of each edge chart's square (and each arc) in the viewport, 1 to 256.
-    #[arg(long, default_value_t = ntori::editor::state::DEFAULT_T, value_name = "A",
+    /// The viewport's quality tessellation: the most a flat triangle strays from the surface, as
+    /// a fraction of its diagonal (1e-5 to 0.1) [default: 0.001].
+    #[arg(long, value_name = "T", conflicts_with_all = ["te", "tr"],
+          value_parser = super::export::parse_tolerance)]
+    tolerance: Option<f64>,
+    /// Show the t_e/t_r tessellation instead, with A divisions of each edge chart's square (and
+    /// each arc), 1 to 256 (t_r is 32 unless given).
+    #[arg(long, value_name = "A",
           value_parser = clap::value_parser!(u32).range(1..=i64::from(ntori::editor::state::MAX_T)))]
-    te: u32,
-    /// Divisions of each wheel spoke in the viewport, 1 to 256.
-    #[arg(long, default_value_t = ntori::editor::state::DEFAULT_T, value_name = "B",
+    te: Option<u32>,
+    /// Show the t_e/t_r tessellation instead, with B divisions of each wheel spoke, 1 to 256 (t_e
+    /// is 32 unless given).
+    #[arg(long, value_name = "B",
           value_parser = clap::value_parser!(u32).range(1..=i64::from(ntori::editor::state::MAX_T)))]
-    tr: u32,
+    tr: Option<u32>,
     /// For smoke tests: close after this many frames.
     #[arg(long, hide = true, value_name = "N")]
     exit_after_frames: Option<u32>,
@@ -43,11 +53,22 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Args {
         model,
+        tolerance,
         te,
         tr,
         exit_after_frames,
         screenshot_on_exit,
     } = args;
+    use ntori::editor::state::DEFAULT_T;
+    use ntori::io::export::Meshing;
+    let meshing = match (te, tr, tolerance) {
+        (None, None, Some(tolerance)) => Meshing::Quality { tolerance },
+        (None, None, None) => Meshing::default(),
+        (te, tr, _) => Meshing::TeTr {
+            te: te.unwrap_or(DEFAULT_T),
+            tr: tr.unwrap_or(DEFAULT_T),
+        },
+    };
     let loaded = model
         .as_deref()
         .map(ntori::io::model_file::load)
@@ -55,7 +76,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let options = ntori::editor::EditorOptions {
         model: loaded,
         file: model,
-        tessellation: (te, tr),
+        meshing,
         exit_after_frames,
         screenshot_on_exit,
         ..Default::default()

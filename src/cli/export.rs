@@ -127,7 +127,7 @@ pub struct Args {
 const DEFAULT_T: u32 = 16;
 
 /// A chordal tolerance within the quality tessellation's range.
-fn parse_tolerance(s: &str) -> Result<f64, String> {
+pub(super) fn parse_tolerance(s: &str) -> Result<f64, String> {
     use embedding::remesh::QualitySettings as Q;
     match s.parse::<f64>() {
         Ok(t) if (Q::MIN_TOLERANCE..=Q::MAX_TOLERANCE).contains(&t) => Ok(t),

@@ -16,8 +16,9 @@ use super::dialogs::{Dialogs, native_dialogs_available};
 use super::jobs::Jobs;
 use super::panels::{self, Messages, SidePanel, Timings};
 use super::recovery::{Orphan, Recovery};
-use super::state::{DEFAULT_T, EditorError, EditorState, Pick};
+use super::state::{EditorError, EditorState, Pick};
 use super::viewport::Viewport;
+use crate::io::export::Meshing;
 
 /// How the editor starts.
 #[derive(Clone, Debug)]
@@ -28,8 +29,8 @@ pub struct EditorOptions {
     pub file: Option<PathBuf>,
     /// Where autosaves go and crash recovery looks (None: no autosave).
     pub recovery_dir: Option<PathBuf>,
-    /// The tessellation (t_e, t_r).
-    pub tessellation: (u32, u32),
+    /// How the viewport's mesh is made: the quality tessellation by default.
+    pub meshing: Meshing,
     /// For smoke tests of the real window: close after this many frames with a model shown,
     /// writing the viewport's picture to `screenshot_on_exit` first (if set).
     pub exit_after_frames: Option<u32>,
@@ -45,7 +46,7 @@ impl Default for EditorOptions {
             model: None,
             file: None,
             recovery_dir: Recovery::default_dir(),
-            tessellation: (DEFAULT_T, DEFAULT_T),
+            meshing: Meshing::default(),
             exit_after_frames: None,
             screenshot_on_exit: None,
             native_dialogs: None,
@@ -80,7 +81,7 @@ pub struct EditorApp {
     /// Where the viewport's picture is to be saved at the end of the frame.
     pub(super) pending_screenshot: Option<PathBuf>,
     /// The tessellation used when the first model arrives.
-    tessellation: (u32, u32),
+    meshing: Meshing,
     smoke: SmokeTest,
     title: String,
 }
@@ -106,7 +107,7 @@ impl EditorApp {
             allow_close: false,
             close_now: false,
             pending_screenshot: None,
-            tessellation: options.tessellation,
+            meshing: options.meshing,
             smoke: SmokeTest {
                 frames: 0,
                 exit_after: options.exit_after_frames,
@@ -114,8 +115,10 @@ impl EditorApp {
             },
             title: String::new(),
         };
-        let (te, tr) = options.tessellation;
-        match options.model.map(|model| EditorState::new(model, te, tr)) {
+        match options
+            .model
+            .map(|model| EditorState::new(model, options.meshing))
+        {
             Some(Ok(mut state)) => {
                 state.set_path(options.file);
                 app.install(state);
@@ -184,8 +187,7 @@ impl EditorApp {
     }
     /// Opens `path` as File → Open does (unsaved changes are dropped).
     pub fn open(&mut self, path: &Path) -> Result<(), EditorError> {
-        let (te, tr) = self.current_t();
-        let state = EditorState::open(path, te, tr)?;
+        let state = EditorState::open(path, self.current_meshing())?;
         self.install(state);
         Ok(())
     }
@@ -198,9 +200,8 @@ impl EditorApp {
         let Some(orphan) = self.orphans.get(i).cloned() else {
             return Err(EditorError::Other("no such recovery file".into()));
         };
-        let (te, tr) = self.current_t();
         let surface = Surface::from_model(&orphan.file.model)?;
-        let mut state = EditorState::new(surface, te, tr)?;
+        let mut state = EditorState::new(surface, self.current_meshing())?;
         state.set_path(orphan.file.original.clone());
         state.mark_modified();
         self.install(state);
@@ -212,10 +213,10 @@ impl EditorApp {
 
     // ------------------------------------------------------------------ state changes
 
-    pub(super) fn current_t(&self) -> (u32, u32) {
+    pub(super) fn current_meshing(&self) -> Meshing {
         self.state
             .as_ref()
-            .map_or(self.tessellation, EditorState::tessellation)
+            .map_or(self.meshing, EditorState::meshing)
     }
 
     /// Shows `state` in place of the current model, in the same viewport.

@@ -14,6 +14,7 @@ use super::app::EditorApp;
 use super::jobs::{JobOutput, JobResult};
 use super::recovery::Recovery;
 use super::state::EditorState;
+use crate::io::export::Meshing;
 use crate::render::{CurvatureKind, Style};
 
 /// A file the user is asked for.
@@ -88,7 +89,9 @@ pub enum Command {
     NextControlNet,
     /// Refit the surface to new spline settings (in the background).
     Refit(SplineSettings),
-    SetTessellation(u32, u32),
+    /// Tessellate the viewport's mesh this way (again, if it already is: after edits the quality
+    /// tessellation is made anew for the new shape).
+    SetMeshing(Meshing),
     RemovePin(usize),
     ClearPins,
     /// Delete the i-th recovery file offered and stop offering it.
@@ -235,7 +238,7 @@ impl EditorApp {
                 FileAction::Export => {
                     if let Some(state) = &self.state {
                         let surface = state.surface().clone();
-                        self.jobs.export(surface, state.tessellation(), path);
+                        self.jobs.export(surface, state.meshing(), path);
                     }
                 }
                 FileAction::Screenshot => self.pending_screenshot = Some(path),
@@ -298,8 +301,8 @@ impl EditorApp {
                     Some(_) => None,
                 };
             }
-            Command::SetTessellation(te, tr) => {
-                if let Err(e) = state.set_tessellation(te, tr) {
+            Command::SetMeshing(meshing) => {
+                if let Err(e) = state.remesh(meshing) {
                     self.messages.error(e.to_string());
                 }
             }
@@ -363,8 +366,7 @@ impl EditorApp {
     fn finish_job(&mut self, result: JobResult) {
         match result {
             Ok(JobOutput::NewModel { genus, surface }) => {
-                let (te, tr) = self.current_t();
-                match EditorState::new(surface, te, tr) {
+                match EditorState::new(surface, self.current_meshing()) {
                     Ok(state) => {
                         self.install(state);
                         self.messages.info(format!("new genus-{genus} model"));
@@ -396,16 +398,16 @@ impl EditorApp {
             }
             Ok(JobOutput::Exported { exported, path }) if exported.folded > 0 => {
                 self.messages.error(format!(
-                    "exported {} triangles to {}, but {} of them face against the surface: \
-                     the tessellation is too coarse for this surface (raise t_e, t_r)",
-                    exported.triangles,
+                    "exported {} to {}, but {} of them face against the surface: \
+                     the tessellation is too coarse for this surface",
+                    exported.face_count(),
                     path.display(),
                     exported.folded
                 ))
             }
             Ok(JobOutput::Exported { exported, path }) => self.messages.info(format!(
-                "exported {} triangles to {}",
-                exported.triangles,
+                "exported {} to {}",
+                exported.face_count(),
                 path.display()
             )),
             Err(e) => self.messages.error(e.to_string()),

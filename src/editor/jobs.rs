@@ -116,14 +116,13 @@ impl Jobs {
         });
     }
 
-    /// Writes the tessellation (t_e, t_r) of `surface` to `path`, in the format its extension
-    /// names.
-    pub fn export(&mut self, surface: Surface, (te, tr): (u32, u32), path: PathBuf) {
+    /// Writes `surface`, tessellated as `meshing` says (the viewport's), to `path`, in the format
+    /// its extension names.
+    pub fn export(&mut self, surface: Surface, meshing: export::Meshing, path: PathBuf) {
         self.spawn("exporting".into(), move || {
             let format = Format::from_path(&path)?;
             let options = export::ExportOptions::default();
-            let exported =
-                export::export_surface(&surface, (te, tr).into(), &path, format, &options)?;
+            let exported = export::export_surface(&surface, meshing, &path, format, &options)?;
             Ok(JobOutput::Exported { exported, path })
         });
     }

@@ -9,14 +9,19 @@
 use std::ops::Range;
 
 use bytemuck::{Pod, Zeroable};
-use charts::Tessellation;
+use charts::{ChartId, ChartPoint};
+use embedding::remesh::{QualitySettings, quality_mesh};
 use embedding::{
     ColumnIndex, ControlId, Point3, Sample, Stencil, Surface, Vector3, Wants, bounding_box,
     evaluate_rows,
 };
 
+use num_complex::Complex64;
+
 use super::camera::Ray;
 use super::pick::{Bvh, Hit};
+use super::state::EditorError;
+use crate::io::export::Meshing;
 use crate::render::scene::{SURFACE_COLOUR, blend_colour, diverging, robust_range};
 use crate::render::{CurvatureKind, Style};
 
@@ -87,9 +92,52 @@ impl Dirty {
     }
 }
 
+/// The triangles the viewport shows, every vertex a chart point: the quality tessellation or the
+/// t_e/t_r one.
+#[derive(Clone, Debug, Default)]
+pub struct ChartTriangles {
+    /// Each vertex in its home chart.
+    pub vertices: Vec<ChartPoint>,
+    /// Counter-clockwise in the triangle's home chart.
+    pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's home chart: one holding all three corners.
+    pub triangle_charts: Vec<ChartId>,
+    /// Each triangle's corners in its home chart's coordinates.
+    pub triangle_coords: Vec<[Complex64; 3]>,
+}
+
+impl ChartTriangles {
+    /// Tessellates `surface` as `meshing` says (quads are shown as their halves).
+    pub fn new(surface: &Surface, meshing: Meshing) -> Result<ChartTriangles, EditorError> {
+        let tolerance = match meshing {
+            Meshing::TeTr { te, tr } => {
+                let t = surface.atlas().tessellate(te, tr)?;
+                return Ok(ChartTriangles {
+                    vertices: t.vertices,
+                    triangles: t.triangles,
+                    triangle_charts: t.triangle_charts,
+                    triangle_coords: t.triangle_coords,
+                });
+            }
+            Meshing::Quality { tolerance } | Meshing::Quads { tolerance } => tolerance,
+        };
+        let settings = QualitySettings {
+            tolerance,
+            ..QualitySettings::default()
+        };
+        let q = quality_mesh(surface, &settings)?;
+        Ok(ChartTriangles {
+            vertices: q.vertices,
+            triangles: q.triangles,
+            triangle_charts: q.triangle_charts,
+            triangle_coords: q.triangle_coords,
+        })
+    }
+}
+
 /// The live surface mesh (see the module documentation).
 pub struct LiveMesh {
-    pub tessellation: Tessellation,
+    pub tessellation: ChartTriangles,
     stencil: Stencil,
     columns: ColumnIndex,
     positions: Vec<Point3>,
@@ -109,14 +157,9 @@ pub struct LiveMesh {
 }
 
 impl LiveMesh {
-    /// Tessellates, builds the stencil and evaluates every vertex.
-    pub fn new(
-        surface: &Surface,
-        te: u32,
-        tr: u32,
-        style: Style,
-    ) -> Result<LiveMesh, charts::ChartsError> {
-        let tessellation = surface.atlas().tessellate(te, tr)?;
+    /// Tessellates as `meshing` says, builds the stencil and evaluates every vertex.
+    pub fn new(surface: &Surface, meshing: Meshing, style: Style) -> Result<LiveMesh, EditorError> {
+        let tessellation = ChartTriangles::new(surface, meshing)?;
         let stencil = Stencil::build(&surface.layout(), &tessellation.vertices);
         let columns = stencil.column_index(surface.control_points().len());
         let n = tessellation.vertices.len();

@@ -9,7 +9,7 @@
 //!   (the key light and uniforms of `render::camera`).
 //! - `pick.rs` — a bounding volume hierarchy over the tessellation's triangles (refitted after
 //!   edits), the exact ray–triangle test, the hit as a chart point.
-//! - `mesh.rs` — the live mesh: tessellation, stencil, exact positions and tangents, the vertices as
+//! - `mesh.rs` — the live mesh: tessellation (the quality one or t_e/t_r's), stencil, exact positions and tangents, the vertices as
 //!   the GPU reads them, what changed since the last upload.
 //! - `drag.rs` — one drag: the minimum-norm solve per event and the vertex update it implies.
 //! - `history.rs` — undo and redo (exact copies of what changed).

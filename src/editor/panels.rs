@@ -11,7 +11,8 @@ use embedding::SplineSettings;
 
 use super::commands::{Command, FileAction, Pending};
 use super::jobs::Jobs;
-use super::state::{EditorState, MAX_T, Pick};
+use super::state::{DEFAULT_T, EditorState, MAX_T, Pick};
+use crate::io::export::Meshing;
 use crate::render::{CurvatureKind, Style};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -206,15 +207,15 @@ fn menu_items<const N: usize>(
 #[derive(Default)]
 pub struct SidePanel {
     draft_settings: SplineSettings,
-    /// The tessellation sliders while they move (applied when let go).
-    draft_t: Option<(u32, u32)>,
+    /// The tessellation's sliders while they move (applied when let go).
+    draft_meshing: Option<Meshing>,
 }
 
 impl SidePanel {
     /// The drafts of a new model: its own settings.
     pub fn reset(&mut self, settings: SplineSettings) {
         self.draft_settings = settings;
-        self.draft_t = None;
+        self.draft_meshing = None;
     }
 
     /// New settings were applied: the draft is them.
@@ -317,7 +318,8 @@ impl SidePanel {
         }
     }
 
-    /// The t_e and t_r sliders, the mesh size they make, and the new tessellation once let go.
+    /// The tessellation: the quality one (its tolerance, and Remesh for the shape as it is now)
+    /// or t_e/t_r (their sliders and the mesh size they make); a change is applied once let go.
     fn tessellation(
         &mut self,
         ui: &mut egui::Ui,
@@ -325,39 +327,77 @@ impl SidePanel {
         commands: &mut Vec<Command>,
     ) {
         ui.label("Tessellation");
-        let (mut te, mut tr) = self.draft_t.unwrap_or(state.tessellation());
-        let a = ui.add(
-            egui::Slider::new(&mut te, 1..=MAX_T)
-                .logarithmic(true)
-                .text("t_e"),
-        );
-        let b = ui.add(
-            egui::Slider::new(&mut tr, 1..=MAX_T)
-                .logarithmic(true)
-                .text("t_r"),
-        );
-        if a.changed() || b.changed() {
-            self.draft_t = Some((te, tr));
-        }
-        let vertices = charts::Tessellation::expected_vertices(state.genus(), te, tr);
-        let triangles = charts::Tessellation::expected_triangles(state.genus(), te, tr);
+        let current = self.draft_meshing.unwrap_or(state.meshing());
+        let mut meshing = current;
+        ui.horizontal(|ui| {
+            let quality = Meshing::default();
+            let is_quality = matches!(meshing, Meshing::Quality { .. });
+            if ui.radio(is_quality, "Quality").clicked() && !is_quality {
+                meshing = quality;
+            }
+            if ui.radio(!is_quality, "t_e, t_r").clicked() && is_quality {
+                meshing = Meshing::TeTr {
+                    te: DEFAULT_T,
+                    tr: DEFAULT_T,
+                };
+            }
+        });
+        let dragged = match &mut meshing {
+            Meshing::Quality { tolerance } | Meshing::Quads { tolerance } => {
+                let slider = ui.add(
+                    egui::Slider::new(tolerance, 1e-4..=1e-2)
+                        .logarithmic(true)
+                        .text("tolerance"),
+                );
+                let dragged = slider.dragged();
+                slider.on_hover_text(
+                    "The most a flat triangle strays from the surface, as a fraction of the \
+                     model's size; triangles follow the curvature",
+                );
+                if ui
+                    .button("Remesh")
+                    .on_hover_text("A new quality tessellation for the shape as it is now")
+                    .clicked()
+                {
+                    commands.push(Command::SetMeshing(meshing));
+                }
+                dragged
+            }
+            Meshing::TeTr { te, tr } => {
+                let a = ui.add(
+                    egui::Slider::new(te, 1..=MAX_T)
+                        .logarithmic(true)
+                        .text("t_e"),
+                );
+                let b = ui.add(
+                    egui::Slider::new(tr, 1..=MAX_T)
+                        .logarithmic(true)
+                        .text("t_r"),
+                );
+                let vertices = charts::Tessellation::expected_vertices(state.genus(), *te, *tr);
+                if vertices > 1_000_000 {
+                    ui.colored_label(
+                        Color32::from_rgb(230, 160, 60),
+                        "Over a million vertices: about 1 GB of memory per million",
+                    );
+                }
+                a.dragged() || b.dragged()
+            }
+        };
+        let mesh = state.mesh();
         ui.label(format!(
             "{} vertices, {} triangles",
-            thousands(vertices),
-            thousands(triangles)
+            thousands(mesh.vertex_count() as u64),
+            thousands(mesh.triangle_count() as u64)
         ));
-        if vertices > 1_000_000 {
-            ui.colored_label(
-                Color32::from_rgb(230, 160, 60),
-                "Over a million vertices: about 1 GB of memory per million",
-            );
+        if meshing != current {
+            self.draft_meshing = Some(meshing);
         }
-        let released = !(a.dragged() || b.dragged());
-        if released
-            && let Some(t) = self.draft_t.take()
-            && t != state.tessellation()
+        if !dragged
+            && let Some(m) = self.draft_meshing.take()
+            && m != state.meshing()
         {
-            commands.push(Command::SetTessellation(t.0, t.1));
+            commands.push(Command::SetMeshing(m));
         }
     }
 }

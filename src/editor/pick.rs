@@ -6,7 +6,9 @@
 //! the boxes grow or shrink, which is O(n) and keeps picking exact; a drag changes the shape little,
 //! so the tree stays good. (An R-tree, as `spatial` uses, would have to be rebuilt after every edit.)
 
-use charts::{ChartPoint, Tessellation};
+use charts::ChartPoint;
+
+use super::mesh::ChartTriangles;
 use embedding::Point3;
 use num_complex::Complex64;
 
@@ -24,7 +26,7 @@ pub struct Hit {
 impl Hit {
     /// The hit as a chart point: the barycentric combination of the triangle's corners in its home
     /// chart (the chart domains are convex, so the point lies in that chart).
-    pub fn chart_point(&self, tessellation: &Tessellation) -> ChartPoint {
+    pub fn chart_point(&self, tessellation: &ChartTriangles) -> ChartPoint {
         let k = self.triangle as usize;
         let corners = tessellation.triangle_coords[k];
         let coords: Complex64 = corners.iter().zip(self.bary).map(|(c, b)| c * b).sum();

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
 use embedding::fit::{FitSettings, vertex_areas};
+use embedding::remesh::QualitySettings;
 use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surface, Vector3};
 
 use super::camera::{OrbitCamera, to_point};
@@ -14,6 +15,7 @@ use super::drag::{DragPlan, DragRow};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
+use crate::io::export::Meshing;
 use crate::io::model_file::ModelFileError;
 use crate::render::Style;
 
@@ -40,7 +42,7 @@ pub enum EditorError {
 
 /// The largest t_e or t_r the editor offers (about 1.3 million vertices at genus 2).
 pub const MAX_T: u32 = 256;
-/// The default tessellation: smooth at genus 2 (about 20 000 vertices), quick at any genus.
+/// The t_e and t_r the panel offers first when switching to the t_e/t_r tessellation.
 pub const DEFAULT_T: u32 = 32;
 
 /// A picked surface point.
@@ -98,8 +100,7 @@ pub struct EditorState {
     /// The document's surface: validated once, when it was loaded, fitted or refitted.
     surface: Surface,
     mesh: LiveMesh,
-    te: u32,
-    tr: u32,
+    meshing: Meshing,
     pub camera: OrbitCamera,
     /// The viewport's size in physical pixels.
     pub viewport: [f64; 2],
@@ -116,18 +117,17 @@ pub struct EditorState {
 }
 
 impl EditorState {
-    /// A state for `surface`, tessellated at t_e, t_r, with the default view.
-    pub fn new(surface: Surface, te: u32, tr: u32) -> Result<EditorState, EditorError> {
-        check_t(te, tr)?;
-        let mesh = LiveMesh::new(&surface, te, tr, Style::Shaded)?;
+    /// A state for `surface`, tessellated as `meshing` says, with the default view.
+    pub fn new(surface: Surface, meshing: Meshing) -> Result<EditorState, EditorError> {
+        check_meshing(meshing)?;
+        let mesh = LiveMesh::new(&surface, meshing, Style::Shaded)?;
         let (centre, radius) = mesh.bounding_sphere();
         Ok(EditorState {
             camera: OrbitCamera::new(centre, radius),
             viewport: [800.0, 600.0],
             surface,
             mesh,
-            te,
-            tr,
+            meshing,
             pins: Vec::new(),
             drag: None,
             history: History::new(),
@@ -140,9 +140,9 @@ impl EditorState {
     }
 
     /// Opens a model file.
-    pub fn open(path: &Path, te: u32, tr: u32) -> Result<EditorState, EditorError> {
+    pub fn open(path: &Path, meshing: Meshing) -> Result<EditorState, EditorError> {
         let surface = crate::io::model_file::load(path)?;
-        let mut state = EditorState::new(surface, te, tr)?;
+        let mut state = EditorState::new(surface, meshing)?;
         state.path = Some(path.to_owned());
         Ok(state)
     }
@@ -182,8 +182,9 @@ impl EditorState {
     pub fn mesh_mut(&mut self) -> &mut LiveMesh {
         &mut self.mesh
     }
-    pub fn tessellation(&self) -> (u32, u32) {
-        (self.te, self.tr)
+    /// How the viewport's mesh is made (and an export from the editor).
+    pub fn meshing(&self) -> Meshing {
+        self.meshing
     }
     pub fn style(&self) -> Style {
         self.mesh.style()
@@ -230,15 +231,21 @@ impl EditorState {
         }
     }
 
-    /// Tessellates anew at t_e, t_r (the view stays).
-    pub fn set_tessellation(&mut self, te: u32, tr: u32) -> Result<(), EditorError> {
-        check_t(te, tr)?;
-        if (te, tr) == (self.te, self.tr) {
+    /// Tessellates anew as `meshing` says (the view stays).
+    pub fn set_meshing(&mut self, meshing: Meshing) -> Result<(), EditorError> {
+        check_meshing(meshing)?;
+        if meshing == self.meshing {
             return Ok(());
         }
-        let mesh = LiveMesh::new(&self.surface, te, tr, self.mesh.style())?;
+        self.remesh(meshing)
+    }
+
+    /// Tessellates the surface as it stands anew (the quality tessellation follows its
+    /// curvature as it was when made; after edits, a new one follows the new shape).
+    pub fn remesh(&mut self, meshing: Meshing) -> Result<(), EditorError> {
+        let mesh = LiveMesh::new(&self.surface, meshing, self.mesh.style())?;
         self.mesh = mesh;
-        (self.te, self.tr) = (te, tr);
+        self.meshing = meshing;
         Ok(())
     }
 
@@ -558,7 +565,7 @@ impl EditorState {
         control: Vec<Point3>,
     ) -> Result<(), EditorError> {
         let surface = Surface::new(self.surface.shared_atlas(), settings, control)?;
-        let mesh = LiveMesh::new(&surface, self.te, self.tr, self.mesh.style())?;
+        let mesh = LiveMesh::new(&surface, self.meshing, self.mesh.style())?;
         self.surface = surface;
         self.mesh = mesh;
         if let Some(c) = self.control_chart
@@ -595,11 +602,21 @@ impl EditorState {
 /// How close (in pixels) a press must be to a pin to grab it.
 pub const PIN_RADIUS_PX: f64 = 7.0;
 
-fn check_t(te: u32, tr: u32) -> Result<(), EditorError> {
-    if !(1..=MAX_T).contains(&te) || !(1..=MAX_T).contains(&tr) {
-        return Err(EditorError::Tessellation { te, tr, max: MAX_T });
+fn check_meshing(meshing: Meshing) -> Result<(), EditorError> {
+    match meshing {
+        Meshing::TeTr { te, tr } if !(1..=MAX_T).contains(&te) || !(1..=MAX_T).contains(&tr) => {
+            Err(EditorError::Tessellation { te, tr, max: MAX_T })
+        }
+        Meshing::Quality { tolerance } | Meshing::Quads { tolerance } => {
+            QualitySettings {
+                tolerance,
+                ..QualitySettings::default()
+            }
+            .check()?;
+            Ok(())
+        }
+        Meshing::TeTr { .. } => Ok(()),
     }
-    Ok(())
 }
 
 /// A model's control points for other spline settings: the new layout fitted (least squares, as the
