@@ -33,7 +33,8 @@ fn model() -> Surface {
 /// A state at t, with two pins and the point to drag: three tessellation vertices spread over the
 /// surface.
 fn setup(model: &Surface, t: u32) -> (EditorState, charts::ChartPoint) {
-    let mut state = EditorState::new(model.clone(), t, t).expect("the model opens");
+    let meshing = ntori::io::export::Meshing::TeTr { te: t, tr: t };
+    let mut state = EditorState::new(model.clone(), meshing).expect("the model opens");
     let n = state.mesh().vertex_count();
     let vertices = &state.mesh().tessellation.vertices;
     let (dragged, pins) = (vertices[n / 3], [vertices[n / 7], vertices[n / 2]]);

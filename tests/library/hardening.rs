@@ -3,6 +3,7 @@
 
 use ntori::editor::gpu::ViewportRenderer;
 use ntori::editor::mesh::LiveMesh;
+use ntori::io::export::Meshing;
 use ntori::render::gpu::{GpuScene, SurfaceVertex};
 use ntori::render::{Offscreen, RenderError, RenderOptions, Style, open_device};
 
@@ -64,7 +65,12 @@ fn gpu_scene_checks_its_buffers_before_uploading() {
 #[test]
 fn editor_upload_checks_its_buffers() {
     let (device, queue, _) = open_device(Some(SMALL_CAP)).expect("a graphics adapter");
-    let mut mesh = LiveMesh::new(small_model(2), 64, 64, Style::Shaded).unwrap();
+    let mut mesh = LiveMesh::new(
+        small_model(2),
+        Meshing::TeTr { te: 64, tr: 64 },
+        Style::Shaded,
+    )
+    .unwrap();
     let mut renderer = ViewportRenderer::new(&device);
     let err = renderer
         .sync(&device, &queue, &mut mesh, None)
@@ -72,7 +78,12 @@ fn editor_upload_checks_its_buffers() {
     assert!(err.to_string().contains("editor's"), "{err}");
     // Asked again (the next frame), the same answer, still without a panic.
     assert!(renderer.sync(&device, &queue, &mut mesh, None).is_err());
-    let mut small = LiveMesh::new(small_model(2), 2, 2, Style::Shaded).unwrap();
+    let mut small = LiveMesh::new(
+        small_model(2),
+        Meshing::TeTr { te: 2, tr: 2 },
+        Style::Shaded,
+    )
+    .unwrap();
     assert!(renderer.sync(&device, &queue, &mut small, None).is_ok());
 }
 
