@@ -228,6 +228,8 @@ struct Remesher<'a> {
     pass: u32,
     /// Passes look only at what changed from this pass on (0: everything).
     since: u32,
+    /// Known, for the running collapse pass, that no triangle is folded.
+    unfolded: bool,
 }
 
 /// Remeshes `surface` into a [`QualityMesh`] (see the module documentation).
@@ -259,10 +261,11 @@ pub fn quality_mesh(
         changed: Vec::new(),
         pass: 0,
         since: 0,
+        unfolded: false,
     };
-    for &p in &start.vertices {
-        let v = r.vertex(p).ok_or_else(|| pinched(p))?;
-        r.verts.push(v);
+    let found: Vec<Option<Vertex>> = start.vertices.par_iter().map(|&p| r.vertex(p)).collect();
+    for (v, &p) in found.into_iter().zip(&start.vertices) {
+        r.verts.push(v.ok_or_else(|| pinched(p))?);
     }
     r.build_rings();
     // The start's triangles wind counter-clockwise in their charts, which is outward.
@@ -285,7 +288,7 @@ pub fn quality_mesh(
     // Refine what is still turned away or bent, let the shapes settle, then make sure of the
     // tolerance.
     r.repeat(|r| r.split_folded());
-    for last in [false, false, true] {
+    for last in [false, true] {
         r.repeat(|r| r.split_bent());
         r.repeat(|r| r.split_chordal());
         // Splits can leave obtuse triangles; Delaunay flips that keep the tolerance mend them.
@@ -929,10 +932,16 @@ impl Remesher<'_> {
             .filter(|e| e.0 < 4.0 / 5.0)
             .collect();
         short.sort_by(|x, y| x.0.total_cmp(&y.0));
-        short
+        // No collapse makes a fold where there was none, so a mesh without one stays so through
+        // the pass, and a collapse need not look for folds to excuse a long edge.
+        let live = self.tris.iter().copied().filter(|t| t[0] != DEAD);
+        self.unfolded = self.folds(live).none();
+        let count = short
             .into_iter()
             .filter(|&(_, a, b)| self.collapse(b, a, false) || self.collapse(a, b, false))
-            .count()
+            .count();
+        self.unfolded = false;
+        count
     }
 
     /// Moves `gone` onto `kept` and removes the two triangles of their edge. `mend`: for a sliver,
@@ -963,7 +972,7 @@ impl Remesher<'_> {
             (self.pos(i) - kept_pos).norm() > 4.0 / 3.0 * limit
         };
         let stretches = || changed.clone().flatten().any(|i| i != kept && too_long(i));
-        if !mend && stretches() && old_folds().none() {
+        if !mend && stretches() && (self.unfolded || old_folds().none()) {
             return false;
         }
         // The link condition: the ends share exactly the two wing vertices.
