@@ -732,7 +732,8 @@ impl Remesher<'_> {
 
     /// Flips an edge of every triangle with an angle under 20°, or else collapses its shortest
     /// edge, where that makes the smallest angle around grow (a cap, with an angle of 150° or more,
-    /// has its other two under 15°).
+    /// has its other two under 15°); a cap no such flip mends is flipped where its largest angle
+    /// shrinks, or else split across its long side.
     fn mend(&mut self) -> usize {
         let limit = 20f64.to_radians();
         let bad: Vec<[u32; 3]> = self
@@ -755,10 +756,18 @@ impl Remesher<'_> {
                 count += 1;
                 continue;
             }
-            // A cap that no flip mends: trade it for a pair with a smaller largest angle.
+            // A cap that no flip mends: trade it for a pair with a smaller largest angle, or else,
+            // where it is one, halve its long side at the surface: two near-right triangles.
             let (a, b) = sides[0];
-            if self.largest_angle(&[t]) >= CAP_ANGLE - UNCAP_MARGIN
-                && self.try_flip(a, b, FlipRule::Uncap)
+            let largest = self.largest_angle(&[t]);
+            if largest >= CAP_ANGLE - UNCAP_MARGIN && self.try_flip(a, b, FlipRule::Uncap) {
+                count += 1;
+                continue;
+            }
+            if largest >= CAP_ANGLE
+                && self.triangle_with(a, b).is_some()
+                && let Some(mid) = self.centre([a, b])
+                && self.split(a, b, mid, false)
             {
                 count += 1;
                 continue;
