@@ -89,7 +89,7 @@ pub struct Args {
     tr: Option<u32>,
     /// The quality tessellation's chordal tolerance: the distance between each flat triangle
     /// and the surface is at most T times the surface's diagonal (1e-5 to 0.1) [default: 0.001].
-    /// On the example models of genus 0 to 10 over 99.9% of triangles have every angle ≥ 20°,
+    /// On the example models of genus 0 to 10 over 99.8% of triangles have every angle ≥ 20°,
     /// none has one of 150° or more, and neighbours bend by under 20°; should a surface defeat
     /// it, a warning says how many triangles face away.
     #[arg(long, value_name = "T", conflicts_with_all = ["te", "tr"], allow_negative_numbers = true,
