@@ -525,6 +525,10 @@ impl Remesher<'_> {
                 }
                 for k in 0..3 {
                     let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
+                    // Each edge once: from the triangle holding it as a→b with a < b.
+                    if a > b {
+                        continue;
+                    }
                     let d = (self.verts[a].pos - self.verts[b].pos).norm();
                     let (sa, sb) = (self.verts[a].size, self.verts[b].size);
                     if sa > sb + GRADATION * d {
@@ -713,16 +717,18 @@ impl Remesher<'_> {
             let p = self.tris[t as usize].map(|i| self.pos(i));
             (p[1] - p[0]).cross(&(p[2] - p[0])).normalize()
         };
-        let mut bent = Vec::new();
-        for (a, b) in self.edges() {
-            // A folded triangle's normal says nothing of the surface's bend.
-            if let Some((t1, _, t2, _)) = self.edge_wings(a, b) {
+        let mut bent: Vec<[u32; 3]> = self
+            .edges()
+            .into_par_iter()
+            .filter_map(|(a, b)| {
+                // A folded triangle's normal says nothing of the surface's bend.
+                let (t1, _, t2, _) = self.edge_wings(a, b)?;
                 let pair = [t1, t2].map(|t| self.tris[t as usize]);
-                if normal(t1).dot(&normal(t2)) < limit && self.folds(pair.into_iter()).none() {
-                    bent.extend(pair);
-                }
-            }
-        }
+                (normal(t1).dot(&normal(t2)) < limit && self.folds(pair.into_iter()).none())
+                    .then_some(pair)
+            })
+            .flatten()
+            .collect();
         // Bisecting each side's longest edge (Rivara) refines without thinning the triangles;
         // splitting the bent edge itself where it is short makes slivers that bend as much.
         bent.sort_unstable();
@@ -945,12 +951,31 @@ impl Remesher<'_> {
         // the pass, and a collapse need not look for folds to excuse a long edge.
         let live = self.tris.iter().copied().filter(|t| t[0] != DEAD);
         self.unfolded = self.folds(live).none();
+        if self.unfolded {
+            // Most short edges would stretch another: those are found on all cores first.
+            short = short
+                .into_par_iter()
+                .filter(|&(_, a, b)| !self.stretches(b, a) || !self.stretches(a, b))
+                .collect();
+        }
         let count = short
             .into_iter()
             .filter(|&(_, a, b)| self.collapse(b, a, false) || self.collapse(a, b, false))
             .count();
         self.unfolded = false;
         count
+    }
+
+    /// Whether moving `gone` onto `kept` would leave an edge from `kept` to one of `gone`'s
+    /// neighbours longer than a split would (4/3 of the smaller target length).
+    fn stretches(&self, gone: u32, kept: u32) -> bool {
+        let kept_vertex = &self.verts[kept as usize];
+        self.ring(gone).iter().any(|&t| {
+            self.tris[t as usize].iter().any(|&i| {
+                let limit = self.verts[i as usize].size.min(kept_vertex.size);
+                i != gone && i != kept && (self.pos(i) - kept_vertex.pos).norm() > 4.0 / 3.0 * limit
+            })
+        })
     }
 
     /// Moves `gone` onto `kept` and removes the two triangles of their edge. `mend`: for a sliver,
@@ -965,7 +990,6 @@ impl Remesher<'_> {
         {
             return false;
         }
-        let kept_pos = self.pos(kept);
         let ring = self.ring(gone);
         let changed = ring
             .iter()
@@ -974,14 +998,7 @@ impl Remesher<'_> {
         let old_folds = || self.folds(ring.iter().map(|&t| self.tris[t as usize]));
         // Where nothing was folded, no edge may come out longer than a split would leave. Most
         // refusals are these: the cheap test goes first.
-        let too_long = |i: u32| {
-            let limit = self.verts[i as usize]
-                .size
-                .min(self.verts[kept as usize].size);
-            (self.pos(i) - kept_pos).norm() > 4.0 / 3.0 * limit
-        };
-        let stretches = || changed.clone().flatten().any(|i| i != kept && too_long(i));
-        if !mend && stretches() && (self.unfolded || old_folds().none()) {
+        if !mend && self.stretches(gone, kept) && (self.unfolded || old_folds().none()) {
             return false;
         }
         // The link condition: the ends share exactly the two wing vertices.
@@ -1028,24 +1045,26 @@ impl Remesher<'_> {
 
     /// Flips edges by `rule` where the two new triangles face outward and keep the surface's bend.
     fn flip(&mut self, rule: FlipRule) -> usize {
-        let mut count = 0;
-        for (a, b) in self.edges() {
-            if self.try_flip(a, b, rule) {
-                count += 1;
-            }
-        }
-        count
+        // Which edges the rule wants flipped, found on all cores; each is tested again when its
+        // turn comes, as the flips before it may have changed its wings (and one they made
+        // wanted is the next pass's).
+        let wanted: Vec<(u32, u32)> = self
+            .edges()
+            .into_par_iter()
+            .filter(|&(a, b)| self.flip_wanted(a, b, rule).is_some())
+            .collect();
+        wanted
+            .into_iter()
+            .filter(|&(a, b)| self.try_flip(a, b, rule))
+            .count()
     }
 
-    fn try_flip(&mut self, a: u32, b: u32, rule: FlipRule) -> bool {
-        let Some((t1, c, t2, d)) = self.edge_wings(a, b) else {
-            return false;
-        };
-        if self.triangle_with(c, d).is_some() {
-            return false;
-        }
-        if self.valence(a) <= 3 || self.valence(b) <= 3 {
-            return false;
+    /// Whether `rule` asks for edge a→b to be flipped, as the mesh is (the flip may still be
+    /// refused: see [`Remesher::try_flip`]); the wings if so.
+    fn flip_wanted(&self, a: u32, b: u32, rule: FlipRule) -> Option<(u32, u32, u32, u32)> {
+        let (t1, c, t2, d) = self.edge_wings(a, b)?;
+        if self.triangle_with(c, d).is_some() || self.valence(a) <= 3 || self.valence(b) <= 3 {
+            return None;
         }
         let wanted = match rule {
             FlipRule::Valence => {
@@ -1058,11 +1077,12 @@ impl Remesher<'_> {
                 after < before
             }
             FlipRule::Delaunay => {
-                let angle = |o: u32, p: u32, q: u32| {
+                // α + β > π, for α, β in (0, π): cot α + cot β < 0 (no arccosines).
+                let cot = |o: u32, p: u32, q: u32| {
                     let (u, v) = (self.pos(p) - self.pos(o), self.pos(q) - self.pos(o));
-                    u.angle(&v)
+                    u.dot(&v) / u.cross(&v).norm()
                 };
-                angle(c, a, b) + angle(d, b, a) > std::f64::consts::PI + 1e-9
+                cot(c, a, b) + cot(d, b, a) < -1e-9
             }
             FlipRule::Mend => {
                 let (old, new) = ([[a, b, c], [b, a, d]], [[a, d, c], [d, b, c]]);
@@ -1075,9 +1095,13 @@ impl Remesher<'_> {
                     && self.least_angle(&new) >= (0.5 * self.least_angle(&old)).min(UNCAP_FLOOR)
             }
         };
-        if !wanted {
+        wanted.then_some((t1, c, t2, d))
+    }
+
+    fn try_flip(&mut self, a: u32, b: u32, rule: FlipRule) -> bool {
+        let Some((t1, c, t2, d)) = self.flip_wanted(a, b, rule) else {
             return false;
-        }
+        };
         let (n1, n2) = ([a, d, c], [d, b, c]);
         let old_folds = self.folds([[a, b, c], [b, a, d]].into_iter());
         if !self.folds([n1, n2].into_iter()).no_worse_than(old_folds) {
