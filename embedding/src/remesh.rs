@@ -69,6 +69,9 @@ const UNCAP_MARGIN: f64 = 10.0 * std::f64::consts::PI / 180.0;
 /// The smallest angle (radians) an uncapping flip may leave, where half the old one is smaller.
 const UNCAP_FLOOR: f64 = 5.0 * std::f64::consts::PI / 180.0;
 
+/// A smoothing step shorter than this fraction of the target length is not made.
+const MOVE_SKIPPED: f64 = 0.02;
+
 /// A smoothing step shorter than this fraction of the target length does not count as a change
 /// (the next round does not look at the vertex again for it).
 const MOVE_NOTICED: f64 = 0.1;
@@ -516,30 +519,30 @@ impl Remesher<'_> {
 
     /// Makes every target length at most its neighbour's plus [`GRADATION`] times their distance.
     fn grade_sizes(&mut self) {
-        for _ in 0..4 {
+        // Each edge once: from the triangle holding it as a→b with a < b.
+        let edges: Vec<(u32, u32)> = self
+            .tris
+            .iter()
+            .filter(|t| t[0] != DEAD)
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .filter(|&(a, b)| a < b)
+            .collect();
+        // Sweeps one way and back: a small size spreads along a chain of edges in either order.
+        for sweep in 0..4 {
             let mut changed = false;
-            for t in 0..self.tris.len() {
-                let tri = self.tris[t];
-                if tri[0] == DEAD {
-                    continue;
-                }
-                for k in 0..3 {
-                    let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
-                    // Each edge once: from the triangle holding it as a→b with a < b.
-                    if a > b {
-                        continue;
-                    }
-                    let d = (self.verts[a].pos - self.verts[b].pos).norm();
-                    let (sa, sb) = (self.verts[a].size, self.verts[b].size);
-                    if sa > sb + GRADATION * d {
-                        self.verts[a].size = sb + GRADATION * d;
-                        self.touch(a as u32);
-                        changed = true;
-                    } else if sb > sa + GRADATION * d {
-                        self.verts[b].size = sa + GRADATION * d;
-                        self.touch(b as u32);
-                        changed = true;
-                    }
+            for k in 0..edges.len() {
+                let (a, b) = edges[if sweep % 2 == 0 { k } else { edges.len() - 1 - k }];
+                let (a, b) = (a as usize, b as usize);
+                let d = (self.verts[a].pos - self.verts[b].pos).norm();
+                let (sa, sb) = (self.verts[a].size, self.verts[b].size);
+                if sa > sb + GRADATION * d {
+                    self.verts[a].size = sb + GRADATION * d;
+                    self.touch(a as u32);
+                    changed = true;
+                } else if sb > sa + GRADATION * d {
+                    self.verts[b].size = sa + GRADATION * d;
+                    self.touch(b as u32);
+                    changed = true;
                 }
             }
             if !changed {
@@ -1173,6 +1176,10 @@ impl Remesher<'_> {
         }
         let step = (sum / weight - vert.pos.coords) * 0.6;
         let step = step - vert.normal * step.dot(&vert.normal);
+        // A vertex nearly where it belongs stays: its new place would cost a surface evaluation.
+        if step.norm() < MOVE_SKIPPED * vert.size {
+            return None;
+        }
         // δw minimising |J δw − step|: the normal equations of the 3×2 Jacobian.
         let (e, f, g) = (
             vert.du.dot(&vert.du),
