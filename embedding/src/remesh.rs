@@ -531,7 +531,11 @@ impl Remesher<'_> {
         for sweep in 0..4 {
             let mut changed = false;
             for k in 0..edges.len() {
-                let (a, b) = edges[if sweep % 2 == 0 { k } else { edges.len() - 1 - k }];
+                let (a, b) = edges[if sweep % 2 == 0 {
+                    k
+                } else {
+                    edges.len() - 1 - k
+                }];
                 let (a, b) = (a as usize, b as usize);
                 let d = (self.verts[a].pos - self.verts[b].pos).norm();
                 let (sa, sb) = (self.verts[a].size, self.verts[b].size);
