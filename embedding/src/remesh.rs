@@ -17,7 +17,8 @@
 //!
 //! Passes are incremental: after a pass over the whole mesh, the next looks only at the triangles
 //! around vertices the one before changed. The surface evaluations of a pass (midpoints, chordal
-//! tests, smoothing targets) are made first, on all cores; the topology changes then run in order.
+//! tests, smoothing targets) and its search for candidates are made first, on all cores; the
+//! topology changes then run in order, each tested again against the mesh as it is by then.
 //!
 //! Every vertex stays a chart point, kept in its deepest chart: midpoints are taken in a chart
 //! holding both ends, and a vertex moves in chart coordinates (the tangent-plane step pulled back
@@ -330,6 +331,17 @@ impl Folds {
     fn no_worse_than(&self, before: Folds) -> bool {
         self.turned == 0 && self.facing_away <= before.facing_away
     }
+}
+
+/// What a collapse is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Purpose {
+    /// An edge shorter than its target length; refused where it would stretch another.
+    Length,
+    /// A sliver: where the smallest angle around grows ([`Remesher::mends`]).
+    Mend,
+    /// A cap: where the largest angle around falls below [`CAP_ANGLE`].
+    Uncap,
 }
 
 /// Which flips a pass makes.
@@ -777,27 +789,86 @@ impl Remesher<'_> {
                 count += 1;
                 continue;
             }
-            if largest >= CAP_ANGLE
-                && self.triangle_with(a, b).is_some()
-                && let Some(mid) = self.centre([a, b])
-                && self.split(a, b, mid, false)
-            {
+            if largest >= CAP_ANGLE && self.uncap(sides) {
                 count += 1;
                 continue;
             }
             // A needle's shortest edge, or a cap's, collapsed.
             let (a, b) = sides[2];
-            if self.collapse(a, b, true) || self.collapse(b, a, true) {
+            if self.collapse(a, b, Purpose::Mend) || self.collapse(b, a, Purpose::Mend) {
                 count += 1;
             }
         }
         count
     }
 
-    /// Whether triangles `new` may replace `old`: their smallest angle is larger, no triangle
-    /// tilts from its corners' normals more than the old ones did (or half the largest bend), and
-    /// each is within the chordal tolerance.
-    fn mends(&self, old: &[[u32; 3]], new: &[[u32; 3]]) -> bool {
+    /// Moves `v` as smoothing would where that makes the largest angle around it smaller and
+    /// folds nothing (a cap's obtuse corner, pulled off its long side).
+    fn relocate(&mut self, v: u32) -> bool {
+        let Some(moved) = self.relaxed(v, true) else {
+            return false;
+        };
+        let around =
+            |r: &Self| -> Vec<[u32; 3]> { r.ring(v).iter().map(|&t| r.tris[t as usize]).collect() };
+        let ring = around(self);
+        let (old_largest, old_folds) =
+            (self.largest_angle(&ring), self.folds(ring.iter().copied()));
+        let saved = std::mem::replace(&mut self.verts[v as usize], moved);
+        let better = self.largest_angle(&ring) < old_largest - 1e-9
+            && self.folds(ring.iter().copied()).no_worse_than(old_folds)
+            && ring
+                .iter()
+                .all(|&t| self.chordal_error(t) <= self.tolerance);
+        if better {
+            self.touch(v);
+        } else {
+            self.verts[v as usize] = saved;
+        }
+        better
+    }
+
+    /// Removes a cap (sides longest first) that no flip mends: its obtuse corner collapsed onto
+    /// an end of its long side, or else the long side split at the surface into near-right
+    /// triangles.
+    fn uncap(&mut self, sides: [(u32, u32); 3]) -> bool {
+        let (a, b) = sides[0];
+        let apex = third([sides[1].0, sides[1].1, sides[2].0], a, b);
+        if self.relocate(apex)
+            || self.collapse(apex, a, Purpose::Uncap)
+            || self.collapse(apex, b, Purpose::Uncap)
+        {
+            return true;
+        }
+        // Below the smallest edge too: the halves are checked to be no caps, so this ends.
+        (self.pos(a) - self.pos(b)).norm() > 0.01 * self.min_edge
+            && self.triangle_with(a, b).is_some()
+            && self
+                .centre([a, b])
+                .is_some_and(|mid| self.halves_uncap(a, b, &mid) && self.split(a, b, mid, false))
+    }
+
+    /// Whether splitting edge a→b at `mid` leaves no angle of [`CAP_ANGLE`] or more in the four
+    /// triangles it makes (at a curvature spike the halves of a cap can be caps again, and
+    /// splitting them on would never end).
+    fn halves_uncap(&self, a: u32, b: u32, mid: &Vertex) -> bool {
+        let Some((_, c, _, d)) = self.edge_wings(a, b) else {
+            return false;
+        };
+        let m = mid.pos;
+        let [pa, pb, pc, pd] = [a, b, c, d].map(|i| self.pos(i));
+        [[pa, m, pc], [m, pb, pc], [pb, m, pd], [m, pa, pd]]
+            .iter()
+            .all(|p| {
+                (0..3).all(|k| (p[(k + 1) % 3] - p[k]).angle(&(p[(k + 2) % 3] - p[k])) < CAP_ANGLE)
+            })
+    }
+
+    /// Whether triangles `new` may replace `old`: for a sliver ([`Purpose::Mend`]) their smallest
+    /// angle is larger and no angle reaches [`CAP_ANGLE`] that had not; for a cap
+    /// ([`Purpose::Uncap`]) their largest angle is smaller and under it, the smallest above half of
+    /// what it was or 5°. Either way no triangle tilts from its corners' normals more than the old
+    /// ones did (or half the largest bend), and each is within the chordal tolerance.
+    fn mends(&self, old: &[[u32; 3]], new: &[[u32; 3]], purpose: Purpose) -> bool {
         let tilt = |ts: &[[u32; 3]]| {
             ts.iter()
                 .map(|&t| {
@@ -809,8 +880,17 @@ impl Remesher<'_> {
                 })
                 .fold(0.0, f64::max)
         };
-        self.least_angle(new) > self.least_angle(old) + 1e-9
-            && self.largest_angle(new) < CAP_ANGLE.max(self.largest_angle(old))
+        let shapes = match purpose {
+            Purpose::Uncap => {
+                self.largest_angle(new) < self.largest_angle(old).min(CAP_ANGLE)
+                    && self.least_angle(new) >= (0.5 * self.least_angle(old)).min(UNCAP_FLOOR)
+            }
+            _ => {
+                self.least_angle(new) > self.least_angle(old) + 1e-9
+                    && self.largest_angle(new) < CAP_ANGLE.max(self.largest_angle(old))
+            }
+        };
+        shapes
             && tilt(new) <= tilt(old).max(0.5 * self.max_bend)
             && new.iter().all(|&t| self.chordal_error(t) <= self.tolerance)
     }
@@ -967,7 +1047,9 @@ impl Remesher<'_> {
         }
         let count = short
             .into_iter()
-            .filter(|&(_, a, b)| self.collapse(b, a, false) || self.collapse(a, b, false))
+            .filter(|&(_, a, b)| {
+                self.collapse(b, a, Purpose::Length) || self.collapse(a, b, Purpose::Length)
+            })
             .count();
         self.unfolded = false;
         count
@@ -985,9 +1067,8 @@ impl Remesher<'_> {
         })
     }
 
-    /// Moves `gone` onto `kept` and removes the two triangles of their edge. `mend`: for a sliver,
-    /// where the smallest angle around grows, instead of for a short edge.
-    fn collapse(&mut self, gone: u32, kept: u32, mend: bool) -> bool {
+    /// Moves `gone` onto `kept` and removes the two triangles of their edge, for `purpose`.
+    fn collapse(&mut self, gone: u32, kept: u32, purpose: Purpose) -> bool {
         let Some((t1, c, t2, d)) = self.edge_wings(kept, gone) else {
             return false;
         };
@@ -1005,7 +1086,10 @@ impl Remesher<'_> {
         let old_folds = || self.folds(ring.iter().map(|&t| self.tris[t as usize]));
         // Where nothing was folded, no edge may come out longer than a split would leave. Most
         // refusals are these: the cheap test goes first.
-        if !mend && self.stretches(gone, kept) && (self.unfolded || old_folds().none()) {
+        if purpose == Purpose::Length
+            && self.stretches(gone, kept)
+            && (self.unfolded || old_folds().none())
+        {
             return false;
         }
         // The link condition: the ends share exactly the two wing vertices.
@@ -1016,10 +1100,10 @@ impl Remesher<'_> {
         if !self.folds(changed.clone()).no_worse_than(old_folds) {
             return false;
         }
-        if mend {
+        if purpose != Purpose::Length {
             let old: Vec<[u32; 3]> = ring.iter().map(|&t| self.tris[t as usize]).collect();
             let new: Vec<[u32; 3]> = changed.collect();
-            if !self.mends(&old, &new) {
+            if !self.mends(&old, &new, purpose) {
                 return false;
             }
         }
@@ -1151,7 +1235,7 @@ impl Remesher<'_> {
         for _ in 0..sweeps {
             let moved: Vec<Option<Vertex>> = (0..self.verts.len() as u32)
                 .into_par_iter()
-                .map(|v| self.relaxed(v))
+                .map(|v| self.relaxed(v, false))
                 .collect();
             for (v, moved) in moved.into_iter().enumerate() {
                 if let Some(moved) = moved {
@@ -1161,8 +1245,9 @@ impl Remesher<'_> {
         }
     }
 
-    /// Where smoothing would move `v` (`None`: nowhere, or `v` is gone).
-    fn relaxed(&self, v: u32) -> Option<Vertex> {
+    /// Where smoothing would move `v` (`None`: nowhere, or `v` is gone). `small`: also a step
+    /// under [`MOVE_SKIPPED`] of the target length.
+    fn relaxed(&self, v: u32, small: bool) -> Option<Vertex> {
         if self.ring(v).is_empty() {
             return None;
         }
@@ -1181,7 +1266,7 @@ impl Remesher<'_> {
         let step = (sum / weight - vert.pos.coords) * 0.6;
         let step = step - vert.normal * step.dot(&vert.normal);
         // A vertex nearly where it belongs stays: its new place would cost a surface evaluation.
-        if step.norm() < MOVE_SKIPPED * vert.size {
+        if !small && step.norm() < MOVE_SKIPPED * vert.size {
             return None;
         }
         // δw minimising |J δw − step|: the normal equations of the 3×2 Jacobian.
