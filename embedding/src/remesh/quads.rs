@@ -207,16 +207,30 @@ impl Builder<'_> {
         })
     }
 
-    /// Quad (a, b, c, d), counter-clockwise, as two triangles of `chart` split along the diagonal
-    /// through its widest corner: a corner near 180° (where a lone triangle's quads meet its long
-    /// side) then opens into both halves instead of flattening one of them.
+    /// Quad (a, b, c, d), counter-clockwise, as two triangles of `chart` split along a diagonal
+    /// whose halves both wind counter-clockwise in the chart (one through a reflex corner, where
+    /// the quad has one), and of two such, the one through its widest corner on the surface: a
+    /// corner near 180° (where a lone triangle's quads meet its long side) then opens into both
+    /// halves instead of flattening one of them.
     fn quad(&mut self, q: [u32; 4], w: [Complex64; 4], chart: ChartId) {
         let p = q.map(|i| self.out.positions[i as usize]);
         let angle = |k: usize| (p[(k + 3) % 4] - p[k]).angle(&(p[(k + 1) % 4] - p[k]));
+        let ccw = |i: usize, j: usize, k: usize| {
+            let (u, v) = (w[j] - w[i], w[k] - w[i]);
+            u.re * v.im - u.im * v.re > 0.0
+        };
+        // Diagonal 0–2 makes (0, 1, 2) and (0, 2, 3); diagonal 1–3 makes (1, 2, 3) and (1, 3, 0).
+        let first = ccw(0, 1, 2) && ccw(0, 2, 3);
+        let second = ccw(1, 2, 3) && ccw(1, 3, 0);
         let widest = (0..4)
             .max_by(|&i, &j| angle(i).total_cmp(&angle(j)))
             .unwrap_or(0);
-        let (q, w) = if widest % 2 == 1 {
+        let through_1_3 = match (first, second) {
+            (true, false) => false,
+            (false, true) => true,
+            _ => widest % 2 == 1,
+        };
+        let (q, w) = if through_1_3 {
             ([q[1], q[2], q[3], q[0]], [w[1], w[2], w[3], w[0]])
         } else {
             (q, w)
