@@ -234,15 +234,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             Meshing::TeTr { .. } => {
                 format!("{meshing} is too coarse for this surface (raise them)")
             }
-            Meshing::Quality { .. } | Meshing::Quads { .. } => {
+            Meshing::Quality { .. } => {
                 "the quality tessellation could not turn them (export with --te and --tr instead)"
                     .to_string()
             }
+            Meshing::Quads { .. } => {
+                "the quad tessellation could not turn them (export without --quads, or with a \
+                 smaller --tolerance)"
+                    .to_string()
+            }
         };
-        eprintln!(
-            "ntori: warning: {} of {} triangles face against the surface's normals: {advice}",
-            exported.folded, exported.triangles
-        );
+        let (folded, all) = (exported.folded, exported.triangles);
+        let what = if exported.quads {
+            format!("{folded} of the {all} halves of the quads")
+        } else {
+            format!("{folded} of {all} triangles")
+        };
+        eprintln!("ntori: warning: {what} face against the surface's normals: {advice}");
     }
     if !quiet {
         let kind = match (format.has_encodings(), encoding) {
