@@ -17,10 +17,14 @@ use num_complex::Complex64;
 use super::{QualityMesh, QualitySettings, quality_mesh};
 use crate::{EmbeddingError, Point3, Surface};
 
-/// How much coarser the triangles are made than the quads' tolerance: splitting each edge at its
-/// surface midpoint divides the chordal error by about four.
+/// How much coarser a tolerance the triangles are made to than the quads': splitting each edge at
+/// its surface midpoint would divide a triangle's chordal error by about four, but a quad is not
+/// flat, and its halves (what a renderer draws) keep more of it. Measured on the example models:
+/// at 1.4 the halves stay within the tolerance (at 2 they reach 1.6 times it).
 pub const TOLERANCE_FACTOR: f64 = 1.4;
 
+/// How much more the triangles may bend than the quads: the split halves the bend across each
+/// edge, and √2 leaves room for the bend within a quad, between its halves.
 const COARSER: f64 = std::f64::consts::SQRT_2;
 
 /// The most a paired quad's corner angle may differ from 90° (degrees); worse pairs stay triangles.
