@@ -45,7 +45,7 @@ use crate::{EmbeddingError, Point3, Surface, Vector3};
 mod quads;
 mod start;
 
-pub use quads::{TOLERANCE_FACTOR as QUAD_TOLERANCE_FACTOR, quad_mesh, quad_of};
+pub use quads::{TOLERANCE_FACTOR as QUAD_TOLERANCE_FACTOR, quad_mesh, quad_of, quads_of};
 
 /// How fast the target edge length may grow from one vertex to its neighbour, per unit distance.
 pub const GRADATION: f64 = 0.35;
@@ -115,6 +115,14 @@ impl QualitySettings {
     /// The largest tolerance accepted.
     pub const MAX_TOLERANCE: f64 = 0.1;
 
+    /// The defaults at chordal tolerance `tolerance` (a fraction of the diagonal).
+    pub fn with_tolerance(tolerance: f64) -> QualitySettings {
+        QualitySettings {
+            tolerance,
+            ..QualitySettings::default()
+        }
+    }
+
     /// Checks the settings' ranges.
     pub fn check(&self) -> Result<(), EmbeddingError> {
         let t = self.tolerance;
@@ -159,10 +167,7 @@ impl QualityMesh {
         if !self.quads {
             return Vec::new();
         }
-        self.triangles
-            .chunks_exact(2)
-            .filter_map(|p| quad_of(p[0], p[1]))
-            .collect()
+        quads_of(&self.triangles)
     }
 
     /// Measures the mesh against the exact surface (not through the remesher's own bookkeeping).
@@ -533,14 +538,8 @@ impl Remesher<'_> {
 
     /// Makes every target length at most its neighbour's plus [`GRADATION`] times their distance.
     fn grade_sizes(&mut self) {
-        // Each edge once: from the triangle holding it as a→b with a < b.
-        let edges: Vec<(u32, u32)> = self
-            .tris
-            .iter()
-            .filter(|t| t[0] != DEAD)
-            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-            .filter(|&(a, b)| a < b)
-            .collect();
+        // Outside a pass: every edge once, in triangle order.
+        let edges = self.edges();
         // Sweeps one way and back: a small size spreads along a chain of edges in either order.
         for sweep in 0..4 {
             let mut changed = false;
@@ -978,14 +977,13 @@ impl Remesher<'_> {
             .par_iter()
             .map(|&(a, b)| self.centre([a, b]))
             .collect();
-        edges
-            .into_iter()
-            .zip(mids)
-            .filter(|&((a, b), ref mid)| match mid {
-                Some(mid) => self.split(a, b, mid.clone(), sizing),
-                None => false,
-            })
-            .count()
+        let mut count = 0;
+        for ((a, b), mid) in edges.into_iter().zip(mids) {
+            if mid.is_some_and(|mid| self.split(a, b, mid, sizing)) {
+                count += 1;
+            }
+        }
+        count
     }
 
     /// Splits edge a–b at the surface point midway in chart coordinates.
@@ -1350,10 +1348,7 @@ mod tests {
     #[test]
     fn tolerance_range_is_checked() {
         for t in [0.0, -1.0, f64::NAN, 0.5] {
-            let s = QualitySettings {
-                tolerance: t,
-                ..QualitySettings::default()
-            };
+            let s = QualitySettings::with_tolerance(t);
             assert!(s.check().is_err(), "{t}");
         }
         assert!(QualitySettings::default().check().is_ok());

@@ -206,19 +206,7 @@ fn the_quad_tessellation_is_closed_convex_and_mostly_square() {
         let q = quad_mesh(&s, &settings).unwrap();
         let quads = q.quad_faces();
         assert_eq!(2 * quads.len(), q.triangles.len(), "genus {genus}");
-        let topology =
-            mesh::HalfEdgeMesh::from_polygons(q.positions.len(), quads.iter().map(|f| &f[..]))
-                .unwrap()
-                .topology();
-        assert!(
-            topology.closed && topology.manifold && topology.orientable,
-            "genus {genus}"
-        );
-        assert_eq!(
-            topology.euler_characteristic,
-            2 - 2 * genus as i64,
-            "genus {genus}"
-        );
+        assert_closed_of_genus(q.positions.len(), quads.iter().map(|f| &f[..]), genus);
         // Both halves counter-clockwise in the quad's chart: the quad is convex there.
         let turned = q
             .triangle_coords
@@ -276,6 +264,22 @@ fn fidelity_finds_a_moved_vertex_and_a_turned_triangle() {
     assert_eq!(q.fidelity(&s).facing_away, 1);
 }
 
+/// The faces make a closed, manifold, oriented surface with χ = 2 − 2·genus.
+fn assert_closed_of_genus<'a>(vertices: usize, faces: impl Iterator<Item = &'a [u32]>, genus: u32) {
+    let topology = mesh::HalfEdgeMesh::from_polygons(vertices, faces)
+        .unwrap()
+        .topology();
+    assert!(
+        topology.closed && topology.manifold && topology.orientable,
+        "genus {genus}"
+    );
+    assert_eq!(
+        topology.euler_characteristic,
+        2 - 2 * genus as i64,
+        "genus {genus}"
+    );
+}
+
 fn check_quality_tessellation(genera: &[u32]) {
     use embedding::remesh::{QualitySettings, quality_mesh};
     let settings = QualitySettings::default();
@@ -292,19 +296,7 @@ fn check_quality_tessellation(genera: &[u32]) {
         let q = quality_mesh(&s, &settings).unwrap();
         let elapsed = start.elapsed();
         let positions: Vec<[f64; 3]> = q.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
-        let topology =
-            mesh::HalfEdgeMesh::from_polygons(positions.len(), q.triangles.iter().map(|t| &t[..]))
-                .unwrap()
-                .topology();
-        assert!(
-            topology.closed && topology.manifold && topology.orientable,
-            "genus {genus}"
-        );
-        assert_eq!(
-            topology.euler_characteristic,
-            2 - 2 * genus as i64,
-            "genus {genus}"
-        );
+        assert_closed_of_genus(positions.len(), q.triangles.iter().map(|t| &t[..]), genus);
         let shape = mesh::mesh_shape(&positions, &q.triangles).unwrap();
         let fidelity = q.fidelity(&s);
         let (worst, folded) = (fidelity.chordal_error, fidelity.facing_away);

@@ -121,11 +121,7 @@ impl ChartTriangles {
             }
             Meshing::Quality { tolerance } | Meshing::Quads { tolerance } => tolerance,
         };
-        let settings = QualitySettings {
-            tolerance,
-            ..QualitySettings::default()
-        };
-        let q = quality_mesh(surface, &settings)?;
+        let q = quality_mesh(surface, &QualitySettings::with_tolerance(tolerance))?;
         Ok(ChartTriangles {
             vertices: q.vertices,
             triangles: q.triangles,

@@ -608,11 +608,7 @@ fn check_meshing(meshing: Meshing) -> Result<(), EditorError> {
             Err(EditorError::Tessellation { te, tr, max: MAX_T })
         }
         Meshing::Quality { tolerance } | Meshing::Quads { tolerance } => {
-            QualitySettings {
-                tolerance,
-                ..QualitySettings::default()
-            }
-            .check()?;
+            QualitySettings::with_tolerance(tolerance).check()?;
             Ok(())
         }
         Meshing::TeTr { .. } => Ok(()),

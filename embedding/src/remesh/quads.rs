@@ -296,6 +296,15 @@ fn split(
     Ok(b.out)
 }
 
+/// The quads whose halves `triangles` are, in pairs (2k, 2k + 1), as [`quad_of`] puts them
+/// together.
+pub fn quads_of(triangles: &[[u32; 3]]) -> Vec<[u32; 4]> {
+    triangles
+        .chunks_exact(2)
+        .filter_map(|p| quad_of(p[0], p[1]))
+        .collect()
+}
+
 /// The quad two triangles sharing an edge make, counter-clockwise as they are: the first's
 /// corners from the far end of the shared edge, then the second's apex. `None` where they share
 /// no edge the same way round.

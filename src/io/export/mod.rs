@@ -398,18 +398,7 @@ pub fn quality_surface_mesh(
     tolerance: f64,
     uv: UvLayout,
 ) -> Result<SurfaceMesh, ExportError> {
-    // Refused before remeshing, counting the vertices the remesher would start from.
-    if surface.is_degenerate() {
-        check_not_degenerate(surface, remesh::start_vertex_count(surface.atlas())? as u64)?;
-    }
-    let settings = QualitySettings {
-        tolerance,
-        ..QualitySettings::default()
-    };
-    let q = quality_mesh(surface, &settings)?;
-    let mut mesh = evaluate_mesh(surface, ChartMesh::from(&q), uv)?;
-    mesh.source = MeshSource::Quality { tolerance };
-    Ok(mesh)
+    remeshed(surface, tolerance, uv, false)
 }
 
 /// The all-quad tessellation of the surface (`embedding::remesh::quad_mesh`: the quality
@@ -420,17 +409,33 @@ pub fn quad_surface_mesh(
     tolerance: f64,
     uv: UvLayout,
 ) -> Result<SurfaceMesh, ExportError> {
+    remeshed(surface, tolerance, uv, true)
+}
+
+/// The quality tessellation (`quads`: the all-quad one) at `tolerance`, evaluated.
+fn remeshed(
+    surface: &Surface,
+    tolerance: f64,
+    uv: UvLayout,
+    quads: bool,
+) -> Result<SurfaceMesh, ExportError> {
+    // Refused before remeshing, counting the vertices the remesher would start from.
     if surface.is_degenerate() {
         check_not_degenerate(surface, remesh::start_vertex_count(surface.atlas())? as u64)?;
     }
-    let settings = QualitySettings {
-        tolerance,
-        ..QualitySettings::default()
+    let settings = QualitySettings::with_tolerance(tolerance);
+    let q = if quads {
+        remesh::quad_mesh(surface, &settings)?
+    } else {
+        quality_mesh(surface, &settings)?
     };
-    let q = remesh::quad_mesh(surface, &settings)?;
     let mut mesh = evaluate_mesh(surface, ChartMesh::from(&q), uv)?;
-    mesh.source = MeshSource::Quads { tolerance };
-    mesh.quads = true;
+    mesh.source = if quads {
+        MeshSource::Quads { tolerance }
+    } else {
+        MeshSource::Quality { tolerance }
+    };
+    mesh.quads = quads;
     Ok(mesh)
 }
 
@@ -653,11 +658,7 @@ impl SurfaceMesh {
 
     /// "N triangles", or "N quads" where the triangles are halves of quads.
     pub fn face_count(&self) -> String {
-        if self.quads {
-            format!("{} quads", self.triangles.len() / 2)
-        } else {
-            format!("{} triangles", self.triangles.len())
-        }
+        face_count(self.triangles.len(), self.quads)
     }
 
     /// The quads whose halves the triangles are ([`SurfaceMesh::quads`]), counter-clockwise as
@@ -666,10 +667,7 @@ impl SurfaceMesh {
         if !self.quads {
             return Vec::new();
         }
-        self.triangles
-            .chunks_exact(2)
-            .filter_map(|p| remesh::quad_of(p[0], p[1]))
-            .collect()
+        remesh::quads_of(&self.triangles)
     }
 
     /// What the texture coordinates are, for file headers.
@@ -812,11 +810,16 @@ pub struct Exported {
 impl Exported {
     /// "N triangles", or "N quads" where the file holds quads.
     pub fn face_count(&self) -> String {
-        if self.quads {
-            format!("{} quads", self.triangles / 2)
-        } else {
-            format!("{} triangles", self.triangles)
-        }
+        face_count(self.triangles, self.quads)
+    }
+}
+
+/// "N triangles", or "N quads" where the `triangles` are halves of quads.
+fn face_count(triangles: usize, quads: bool) -> String {
+    if quads {
+        format!("{} quads", triangles / 2)
+    } else {
+        format!("{triangles} triangles")
     }
 }
 
