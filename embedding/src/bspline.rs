@@ -53,15 +53,150 @@ impl UniformBasis {
 
     /// The p + 1 basis functions that do not vanish at x (clamped into [−½, ½]) and their derivatives
     /// up to order `derivs` (≤ p): returns (index of the first, `table[d][j]` = d-th derivative of basis
-    /// function first + j). The Cox–de Boor triangle and its derivative form (Piegl and Tiller's
-    /// algorithm A2.3), on uniform knots.
+    /// function first + j).
+    ///
+    /// The knots are uniform, so on every span the live functions are the same p + 1 polynomials of
+    /// the local parameter t ∈ [0, 1) (Cox–de Boor's recurrence on unit knots), and the
+    /// derivatives are differences of the lower degrees' values, scaled by h⁻¹ per order.
     pub fn eval(&self, x: f64, derivs: usize) -> (usize, [[f64; MAX_DEGREE + 1]; 4]) {
         let p = self.degree;
         let derivs = derivs.min(p).min(3);
         let x = x.clamp(-0.5, 0.5);
         // Knot span: t_span ≤ x < t_{span+1}, span ∈ [p, count − 1].
         let span = (((x + 0.5) / self.h).floor() as usize + p).min(self.count - 1);
-        let knot = |i: usize| self.knot(i as isize);
+        let t = (x - self.knot(span as isize)) / self.h;
+        // One copy per degree: the loops unroll and the bounds checks go.
+        let table = match p {
+            1 => span_table::<1>(t, derivs, self.h),
+            2 => span_table::<2>(t, derivs, self.h),
+            3 => span_table::<3>(t, derivs, self.h),
+            4 => span_table::<4>(t, derivs, self.h),
+            5 => span_table::<5>(t, derivs, self.h),
+            6 => span_table::<6>(t, derivs, self.h),
+            _ => span_table::<MAX_DEGREE>(t, derivs, self.h),
+        };
+        (span - p, table)
+    }
+}
+
+/// Zeros before each row of [`unit_triangle`], so that differences of up to third order need no
+/// bounds tests.
+const PAD: usize = 3;
+
+/// One degree's values on a span, behind [`PAD`] zeros and followed by zeros.
+type Level = [f64; MAX_DEGREE + 1 + PAD];
+
+/// (−1)^(d+s) C(d, s) for d, s ≤ 3: the d-th derivative on unit knots of the function with index j
+/// is Σ_s `DIFFERENCES[d][s]` · (the degree p − d value with index j − s), from
+/// N'_{j} = N_{j−1} − N_{j} one degree down, applied d times.
+const DIFFERENCES: [[f64; 4]; 4] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [-1.0, 1.0, 0.0, 0.0],
+    [1.0, -2.0, 1.0, 0.0],
+    [-1.0, 3.0, -3.0, 1.0],
+];
+
+/// The d-th derivative on unit knots, from the values one level of degree d lower.
+fn difference(lower: &Level, d: usize, j: usize) -> f64 {
+    let w = &DIFFERENCES[d];
+    let i = PAD + j;
+    w[0] * lower[i] + w[1] * lower[i - 1] + w[2] * lower[i - 2] + w[3] * lower[i - 3]
+}
+
+/// [`UniformBasis::eval`]'s table at local parameter t of a span, knot spacing h.
+fn span_table<const P: usize>(t: f64, derivs: usize, h: f64) -> [[f64; MAX_DEGREE + 1]; 4] {
+    let levels = unit_triangle_of::<P>(t);
+    let mut out = [[0.0; MAX_DEGREE + 1]; 4];
+    let mut scale = 1.0;
+    for (d, row) in out.iter_mut().enumerate().take(derivs + 1) {
+        for (j, v) in row.iter_mut().enumerate().take(P + 1) {
+            *v = scale * difference(&levels[P - d], d, j);
+        }
+        scale /= h;
+    }
+    out
+}
+
+/// The B-splines of every degree k ≤ p on unit knots that are alive on the span [0, 1), at t in
+/// it: `levels[k][PAD + j]`, j = 0..=k, is the one whose support starts at j − k. Cox–de Boor's
+/// recurrence with unit knot spacing.
+fn unit_triangle(p: usize, t: f64) -> [Level; MAX_DEGREE + 1] {
+    match p {
+        0 => unit_triangle_of::<0>(t),
+        1 => unit_triangle_of::<1>(t),
+        2 => unit_triangle_of::<2>(t),
+        3 => unit_triangle_of::<3>(t),
+        4 => unit_triangle_of::<4>(t),
+        5 => unit_triangle_of::<5>(t),
+        6 => unit_triangle_of::<6>(t),
+        _ => unit_triangle_of::<MAX_DEGREE>(t),
+    }
+}
+
+fn unit_triangle_of<const P: usize>(t: f64) -> [Level; MAX_DEGREE + 1] {
+    let mut levels = [[0.0; MAX_DEGREE + 1 + PAD]; MAX_DEGREE + 1];
+    levels[0][PAD] = 1.0;
+    for k in 1..=P {
+        let inv = 1.0 / k as f64;
+        for j in 0..=k {
+            // N^k_j = ((t + k − j) N^{k−1}_{j−1} + (j + 1 − t) N^{k−1}_j) / k; the row below is
+            // zero at j − 1 = −1 (the padding) and at j = k.
+            let (below, here) = (levels[k - 1][PAD + j - 1], levels[k - 1][PAD + j]);
+            levels[k][PAD + j] = ((t + (k - j) as f64) * below + (j as f64 + 1.0 - t) * here) * inv;
+        }
+    }
+    levels
+}
+
+/// [`cardinal`]'s value alone.
+pub fn cardinal_value(d: usize, x: f64) -> f64 {
+    let y = x * (d + 1) as f64;
+    let m = y.floor();
+    if !(0.0..=d as f64).contains(&m) {
+        return 0.0;
+    }
+    unit_triangle(d, y - m)[d][PAD + d - m as usize]
+}
+
+/// The cardinal B-spline of degree d on the knots 0, 1/(d+1), …, 1, and its derivatives up to order
+/// 3 at x: a bump on (0, 1), C^{d−1}, vanishing with its first d − 1 derivatives at 0 and 1. The blend
+/// functions use d = k + 1 for continuity order k.
+pub fn cardinal(d: usize, x: f64) -> [f64; 4] {
+    let n = (d + 1) as f64;
+    let y = x * n; // integer knots 0..=d+1
+    let mut out = [0.0; 4];
+    let m = y.floor();
+    if !(0.0..=d as f64).contains(&m) {
+        return out;
+    }
+    // On the span [m, m + 1) the bump N_d is the degree-d function starting at 0, index d − m.
+    let levels = unit_triangle(d, y - m);
+    let mut scale = 1.0;
+    for (r, o) in out.iter_mut().enumerate().take(d.min(3) + 1) {
+        *o = scale * difference(&levels[d - r], r, d - m as usize);
+        scale *= n;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The general algorithm (Piegl and Tiller's A2.3, any knots) on the basis's knots: the
+    /// oracle for the uniform recurrence.
+    fn piegl_tiller(
+        b: &UniformBasis,
+        x: f64,
+        derivs: usize,
+    ) -> (usize, [[f64; MAX_DEGREE + 1]; 4]) {
+        let p = b.degree;
+        let derivs = derivs.min(p).min(3);
+        let x = x.clamp(-0.5, 0.5);
+        // Knot span: t_span ≤ x < t_{span+1}, span ∈ [p, count − 1].
+        let span = (((x + 0.5) / b.h).floor() as usize + p).min(b.count - 1);
+        let knot = |i: usize| b.knot(i as isize);
         // ndu[j][r]: basis values (upper triangle) and knot differences (lower), as in A2.3.
         let mut ndu = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
         let (mut left, mut right) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
@@ -122,48 +257,74 @@ impl UniformBasis {
         }
         (span - p, out)
     }
-}
 
-/// The cardinal B-spline of degree d on the knots 0, 1/(d+1), …, 1, and its derivatives up to order
-/// 3 at x: a bump on (0, 1), C^{d−1}, vanishing with its first d − 1 derivatives at 0 and 1. The blend
-/// functions use d = k + 1 for continuity order k.
-pub fn cardinal(d: usize, x: f64) -> [f64; 4] {
-    let n = (d + 1) as f64;
-    let y = x * n; // integer knots 0..=d+1
-    let mut out = [0.0; 4];
-    let mut scale = 1.0;
-    for (r, o) in out.iter_mut().enumerate() {
-        if r <= d {
-            // N_d^(r)(y) = Σ_s (−1)^s C(r, s) N_{d−r}(y − s)
-            let mut acc = 0.0;
-            let mut binom = 1.0;
-            for s in 0..=r {
-                let sign = if s % 2 == 0 { 1.0 } else { -1.0 };
-                acc += sign * binom * integer_bspline(d - r, y - s as f64);
-                binom = binom * (r - s) as f64 / (s + 1) as f64;
-            }
-            *o = acc * scale;
+    /// The B-spline of degree q on integer knots 0, 1, …, q + 1, by its recursive definition.
+    fn integer_bspline(q: usize, y: f64) -> f64 {
+        if q == 0 {
+            return if (0.0..1.0).contains(&y) { 1.0 } else { 0.0 };
         }
-        scale *= n;
+        if y <= 0.0 || y >= (q + 1) as f64 {
+            return 0.0;
+        }
+        let qf = q as f64;
+        (y * integer_bspline(q - 1, y) + (qf + 1.0 - y) * integer_bspline(q - 1, y - 1.0)) / qf
     }
-    out
-}
 
-/// The B-spline of degree q on integer knots 0, 1, …, q + 1 (support [0, q + 1]).
-fn integer_bspline(q: usize, y: f64) -> f64 {
-    if q == 0 {
-        return if (0.0..1.0).contains(&y) { 1.0 } else { 0.0 };
-    }
-    if y <= 0.0 || y >= (q + 1) as f64 {
-        return 0.0;
-    }
-    let qf = q as f64;
-    (y * integer_bspline(q - 1, y) + (qf + 1.0 - y) * integer_bspline(q - 1, y - 1.0)) / qf
-}
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+        #[test]
+        fn uniform_recurrence_matches_the_general_algorithm(
+            p in 1..=MAX_DEGREE,
+            extra in 1usize..40,
+            x in -0.6f64..0.6,
+        ) {
+            let b = UniformBasis::new(p, p + extra).unwrap();
+            let (first, fast) = b.eval(x, 3);
+            let (first_ref, slow) = piegl_tiller(&b, x, 3);
+            prop_assert_eq!(first, first_ref);
+            // Each derivative order scales by h⁻¹.
+            let mut scale: f64 = 1.0;
+            for d in 0..=p.min(3) {
+                for j in 0..=p {
+                    prop_assert!(
+                        (fast[d][j] - slow[d][j]).abs() <= 1e-12 * scale,
+                        "d {} j {}: {} vs {}", d, j, fast[d][j], slow[d][j]
+                    );
+                }
+                scale /= b.h;
+            }
+        }
+
+        /// Inside the support, outside it, and on its integer knots.
+        #[test]
+        fn cardinal_matches_its_recursive_definition(
+            d in 2usize..=5,
+            x in -0.2f64..1.2,
+            knot in prop::option::of(-1i32..8),
+        ) {
+            let n = (d + 1) as f64;
+            let x = knot.map_or(x, |k| k as f64 / n);
+            let fast = cardinal(d, x);
+            prop_assert_eq!(cardinal_value(d, x), fast[0]);
+            let mut scale = 1.0;
+            for (r, &value) in fast.iter().enumerate().take(d.min(3) + 1) {
+                let mut slow = 0.0;
+                let mut binom = 1.0;
+                for s in 0..=r {
+                    let sign = if s % 2 == 0 { 1.0 } else { -1.0 };
+                    slow += sign * binom * integer_bspline(d - r, x * n - s as f64);
+                    binom = binom * (r - s) as f64 / (s + 1) as f64;
+                }
+                slow *= scale;
+                prop_assert!(
+                    (value - slow).abs() <= 1e-12 * scale,
+                    "r {}: {} vs {}", r, value, slow
+                );
+                scale *= n;
+            }
+        }
+    }
 
     #[test]
     fn derivatives_match_finite_differences() {

@@ -249,36 +249,7 @@ pub fn quality_mesh(
     settings: &QualitySettings,
 ) -> Result<QualityMesh, EmbeddingError> {
     settings.check()?;
-    // A coarse start with the right topology; its slivers are remeshed away.
-    let start = start::start_mesh(surface.atlas(), START_RESOLUTION)?;
-    // The surface's own size (its control net can reach far beyond it).
-    let positions: Vec<Point3> = start
-        .vertices
-        .iter()
-        .map(|&p| surface.eval(p).pos)
-        .collect();
-    let diagonal = crate::fit::diagonal(&positions);
-    let mut r = Remesher {
-        surface,
-        tolerance: settings.tolerance * diagonal,
-        bend: settings.bend,
-        max_bend: settings.max_bend.to_radians(),
-        max_edge: settings.max_edge * diagonal,
-        min_edge: 1e-4 * diagonal,
-        verts: Vec::with_capacity(start.vertices.len()),
-        tris: start.triangles,
-        rings: Vec::new(),
-        chordal_fine: HashSet::new(),
-        changed: Vec::new(),
-        pass: 0,
-        since: 0,
-        unfolded: false,
-    };
-    let found: Vec<Option<Vertex>> = start.vertices.par_iter().map(|&p| r.vertex(p)).collect();
-    for (v, &p) in found.into_iter().zip(&start.vertices) {
-        r.verts.push(v.ok_or_else(|| pinched(p))?);
-    }
-    r.build_rings();
+    let mut r = Remesher::start(surface, settings)?;
     // The start's triangles wind counter-clockwise in their charts, which is outward.
     // Clean the start's slivers before refining: splitting a sliver makes more of them.
     r.repeat(|r| r.collapse_short());
@@ -310,6 +281,46 @@ pub fn quality_mesh(
     }
     r.repeat(|r| r.mend());
     r.finish()
+}
+
+impl<'a> Remesher<'a> {
+    /// The coarse start mesh on `surface`: the right topology, its slivers still to be
+    /// remeshed away.
+    fn start(
+        surface: &'a Surface,
+        settings: &QualitySettings,
+    ) -> Result<Remesher<'a>, EmbeddingError> {
+        let start = start::start_mesh(surface.atlas(), START_RESOLUTION)?;
+        // The surface's own size (its control net can reach far beyond it).
+        let positions: Vec<Point3> = start
+            .vertices
+            .par_iter()
+            .map(|&p| surface.position(p))
+            .collect();
+        let diagonal = crate::fit::diagonal(&positions);
+        let mut r = Remesher {
+            surface,
+            tolerance: settings.tolerance * diagonal,
+            bend: settings.bend,
+            max_bend: settings.max_bend.to_radians(),
+            max_edge: settings.max_edge * diagonal,
+            min_edge: 1e-4 * diagonal,
+            verts: Vec::with_capacity(start.vertices.len()),
+            tris: start.triangles,
+            rings: Vec::new(),
+            chordal_fine: HashSet::new(),
+            changed: Vec::new(),
+            pass: 0,
+            since: 0,
+            unfolded: false,
+        };
+        let found: Vec<Option<Vertex>> = start.vertices.par_iter().map(|&p| r.vertex(p)).collect();
+        for (v, &p) in found.into_iter().zip(&start.vertices) {
+            r.verts.push(v.ok_or_else(|| pinched(p))?);
+        }
+        r.build_rings();
+        Ok(r)
+    }
 }
 
 fn pinched(p: ChartPoint) -> EmbeddingError {
@@ -375,15 +386,26 @@ impl Remesher<'_> {
     /// `p` lies outside its chart.
     fn vertex(&self, p: ChartPoint) -> Option<Vertex> {
         let atlas = self.surface.atlas();
-        let located = atlas.locate(p).ok()?;
-        let reps = located.representations().to_vec();
-        let point = *reps.iter().max_by(|a, b| {
-            let ma = atlas.charts()[a.chart.index()].domain().margin(a.coords);
-            let mb = atlas.charts()[b.chart.index()].domain().margin(b.coords);
-            ma.total_cmp(&mb)
-        })?;
-        let jet = self.surface.eval(point);
-        let cross = jet.du.cross(&jet.dv);
+        let domain = atlas.chart(p.chart).ok()?.domain();
+        if !(p.coords.re.is_finite() && p.coords.im.is_finite() && domain.margin(p.coords) > 0.0) {
+            return None;
+        }
+        // One location serves both the evaluation (in p's chart) and the choice of home chart.
+        let located = atlas.locate_with_transitions(p);
+        let margin = |q: &ChartPoint| atlas.charts()[q.chart.index()].domain().margin(q.coords);
+        let &(point, psi) = located
+            .iter()
+            .max_by(|a, b| margin(&a.0).total_cmp(&margin(&b.0)))?;
+        let jet = self.surface.eval_located(p, &located);
+        // The derivatives in the home chart: ψ⁻¹ has complex derivative 1/ψ'(w) = a + ib, so
+        // ∂/∂u' = a ∂/∂u + b ∂/∂v and ∂/∂v' = −b ∂/∂u + a ∂/∂v (Cauchy–Riemann). Curvatures
+        // do not depend on the chart.
+        let [_, _, c, d] = psi.matrix();
+        let q = c * p.coords + d;
+        let g = q * q;
+        let du = jet.du * g.re + jet.dv * g.im;
+        let dv = jet.dv * g.re - jet.du * g.im;
+        let cross = du.cross(&dv);
         let area = cross.norm();
         if area.is_nan() || area <= 1e-12 * self.max_edge * self.max_edge {
             return None;
@@ -392,10 +414,10 @@ impl Remesher<'_> {
         let kappa = k1.abs().max(k2.abs());
         Some(Vertex {
             point,
-            reps,
+            reps: located.iter().map(|r| r.0).collect(),
             pos: jet.pos,
-            du: jet.du,
-            dv: jet.dv,
+            du,
+            dv,
             normal: cross / area,
             size: self.size_for(kappa),
         })
@@ -639,30 +661,27 @@ impl Remesher<'_> {
         })
     }
 
-    /// The edges (a < b) of the triangles the running pass looks at, each once (a closed manifold
-    /// mesh holds a→b in one triangle and b→a in another), in triangle order on a first pass:
-    /// the same input gives the same mesh.
+    /// The edges (a < b) of the triangles the running pass looks at, each once, in triangle
+    /// order: the same input gives the same mesh. A closed manifold mesh holds a→b in one
+    /// triangle and b→a in another; the one holding it with a < b lists it, unless that one is
+    /// not looked at, in which case the other does.
     fn edges(&self) -> Vec<(u32, u32)> {
+        let changed = |v: u32| self.since == 0 || self.changed[v as usize] >= self.since;
         let mut edges = Vec::with_capacity(self.tris.len() * 3 / 2);
-        if self.since == 0 {
-            for tri in self.live_triangles() {
-                for k in 0..3 {
-                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    if a < b {
-                        edges.push((a, b));
+        for tri in self.live_triangles() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if a < b {
+                    edges.push((a, b));
+                } else if !changed(a) && !changed(b) {
+                    // This triangle is looked at for its third corner: the edge's other triangle
+                    // is looked at only if its own third corner changed.
+                    let other = self.triangle_with(b, a);
+                    if other.is_some_and(|t| !changed(third(self.tris[t as usize], b, a))) {
+                        edges.push((b, a));
                     }
                 }
             }
-        } else {
-            // An edge's other triangle may be the one that changed: take every edge both ways.
-            for tri in self.live_triangles() {
-                for k in 0..3 {
-                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    edges.push((a.min(b), a.max(b)));
-                }
-            }
-            edges.sort_unstable();
-            edges.dedup();
         }
         edges
     }
@@ -721,11 +740,11 @@ impl Remesher<'_> {
     fn split_long(&mut self) -> usize {
         let mut long: Vec<(f64, u32, u32)> = self
             .edges()
-            .into_iter()
+            .into_par_iter()
             .map(|(a, b)| (self.relative_length(a, b), a, b))
             .filter(|e| e.0 > 4.0 / 3.0)
             .collect();
-        long.sort_by(|x, y| y.0.total_cmp(&x.0));
+        long.par_sort_by(|x, y| y.0.total_cmp(&x.0));
         self.split_edges(long.into_iter().map(|(_, a, b)| (a, b)).collect(), true)
     }
 
@@ -1029,15 +1048,18 @@ impl Remesher<'_> {
     fn collapse_short(&mut self) -> usize {
         let mut short: Vec<(f64, u32, u32)> = self
             .edges()
-            .into_iter()
+            .into_par_iter()
             .map(|(a, b)| (self.relative_length(a, b), a, b))
             .filter(|e| e.0 < 4.0 / 5.0)
             .collect();
-        short.sort_by(|x, y| x.0.total_cmp(&y.0));
+        short.par_sort_by(|x, y| x.0.total_cmp(&y.0));
         // No collapse makes a fold where there was none, so a mesh without one stays so through
         // the pass, and a collapse need not look for folds to excuse a long edge.
-        let live = self.tris.iter().copied().filter(|t| t[0] != DEAD);
-        self.unfolded = self.folds(live).none();
+        self.unfolded = self
+            .tris
+            .par_iter()
+            .filter(|t| t[0] != DEAD)
+            .all(|&t| self.folds(std::iter::once(t)).none());
         if self.unfolded {
             // Most short edges would stretch another: those are found on all cores first.
             short = short
@@ -1338,6 +1360,49 @@ fn third(t: [u32; 3], a: u32, b: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every edge of the triangles with a corner changed since a pass, each once, as sorting
+    /// both orientations of every such triangle's edges finds them.
+    #[test]
+    fn a_later_pass_sees_each_edge_of_what_changed_once() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../assets/models/genus-2.json"
+        ))
+        .unwrap();
+        let model: crate::Model = serde_json::from_str(&text).unwrap();
+        let surface = Surface::from_model(&model).unwrap();
+        let mut r = Remesher::start(&surface, &QualitySettings::default()).unwrap();
+        r.repeat_at_most(2, |r| r.split_long());
+        r.repeat_at_most(2, |r| r.collapse_short());
+        let mut checked = 0;
+        for since in 1..=r.pass {
+            r.since = since;
+            let mut expected: Vec<(u32, u32)> = r
+                .live_triangles()
+                .flat_map(|t| {
+                    (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+                })
+                .collect();
+            expected.sort_unstable();
+            expected.dedup();
+            let mut found = r.edges();
+            let listed = found.len();
+            found.sort_unstable();
+            found.dedup();
+            assert_eq!(
+                found.len(),
+                listed,
+                "since pass {since}: an edge listed twice"
+            );
+            assert_eq!(found, expected, "since pass {since}");
+            checked += listed;
+        }
+        assert!(
+            checked > 1000,
+            "the passes changed too little to test: {checked}"
+        );
+    }
 
     #[test]
     fn third_corner() {

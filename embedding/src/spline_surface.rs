@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use charts::{Atlas, ChartPoint};
+use charts::{Atlas, ChartPoint, Lft};
 
 use crate::EmbeddingError;
 use crate::bspline::UniformBasis;
@@ -145,6 +145,12 @@ impl Surface {
     /// S and its first and second derivatives at `p`, in `p.chart`'s coordinates.
     pub fn eval(&self, p: ChartPoint) -> SurfaceJet {
         self.layout().eval(&self.control, p)
+    }
+
+    /// [`Surface::eval`] at a point already located: `reps` is what
+    /// [`charts::Atlas::locate_with_transitions`] gives for `p`.
+    pub(crate) fn eval_located(&self, p: ChartPoint, reps: &[(ChartPoint, Lft)]) -> SurfaceJet {
+        self.layout().eval_located(&self.control, p, reps)
     }
 
     /// S at `p` (no derivatives: cheaper than [`Surface::eval`]).

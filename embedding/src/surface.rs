@@ -10,7 +10,7 @@ use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
 use crate::EmbeddingError;
-use crate::bspline::{UniformBasis, cardinal};
+use crate::bspline::{UniformBasis, cardinal, cardinal_value};
 
 /// A position in R³: a point of the surface, a control point. Distinct from chart and model points,
 /// and from [`Vector3`]: positions subtract to vectors, and only vectors add, scale and cross.
@@ -255,7 +255,8 @@ impl<'a> Layout<'a> {
                 Jet::tensor([x[0], x[1], x[2]], [y[0], y[1], y[2]])
             }
             Domain::Disk => {
-                let r = w.norm();
+                // |w| < 2 in a disk chart: no overflow for hypot to guard against.
+                let r = w.norm_sqr().sqrt();
                 let b = cardinal(d, 0.5 + r);
                 if r < 1e-9 {
                     // Even about the centre: the gradient vanishes, the Hessian is B''·I.
@@ -276,6 +277,15 @@ impl<'a> Layout<'a> {
                     dvv: b[2] * uy * uy + b[1] * (1.0 - uy * uy) / r,
                 }
             }
+        }
+    }
+
+    /// [`Layout::raw_blend`]'s value alone.
+    pub fn raw_blend_value(&self, domain: Domain, w: Complex64) -> f64 {
+        let d = self.settings.continuity + 1;
+        match domain {
+            Domain::Square => cardinal_value(d, w.re + 0.5) * cardinal_value(d, w.im + 0.5),
+            Domain::Disk => cardinal_value(d, 0.5 + w.norm_sqr().sqrt()),
         }
     }
 
@@ -353,7 +363,7 @@ impl<'a> Layout<'a> {
         for (rep, _) in self.atlas.locate_with_transitions(p) {
             let chart = &self.atlas.charts()[rep.chart.index()];
             let w = rep.coords;
-            let blend = self.raw_blend(chart.domain(), w).val;
+            let blend = self.raw_blend_value(chart.domain(), w);
             let (fu, nu) = self.basis.eval(w.re, 0);
             let (fv, nv) = self.basis.eval(w.im, 0);
             let mut patch = Vector3::zeros();
@@ -376,10 +386,21 @@ impl<'a> Layout<'a> {
     /// with its basis functions' jets first, and the blend, the chain rule and the quotient act on
     /// the patch (three coordinate jets) rather than on each of its (degree + 1)² weights.
     pub fn eval(&self, control: &[Point3], p: ChartPoint) -> SurfaceJet {
+        self.eval_located(control, p, &self.atlas.locate_with_transitions(p))
+    }
+
+    /// [`Layout::eval`] where `p` is already located: `reps` is what
+    /// [`Atlas::locate_with_transitions`] gives for it.
+    pub(crate) fn eval_located(
+        &self,
+        control: &[Point3],
+        p: ChartPoint,
+        reps: &[(ChartPoint, Lft)],
+    ) -> SurfaceJet {
         let p1 = self.settings.degree + 1;
         let mut numerator = [Jet::default(); 3];
         let mut denominator = Jet::default();
-        for (rep, psi) in self.atlas.locate_with_transitions(p) {
+        for &(rep, psi) in reps {
             let chart = &self.atlas.charts()[rep.chart.index()];
             let w = rep.coords;
             let (d1, d2) = derivatives(&psi, p.coords);

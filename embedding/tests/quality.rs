@@ -234,8 +234,7 @@ fn the_quad_tessellation_is_closed_convex_and_mostly_square() {
             100.0 * square,
             fidelity.chordal_error
         );
-        let allowed = if genus == 10 { 3 } else { 0 };
-        if turned + fidelity.facing_away > allowed
+        if turned + fidelity.facing_away > 0
             || fidelity.chordal_error > 1.1 * settings.tolerance
             || square < 0.85
         {

@@ -157,6 +157,20 @@ fn in_chart(atlas: &charts::Atlas, p: ChartPoint, chart: ChartId) -> Option<Comp
         .map(|r| r.coords)
 }
 
+/// The midpoint of the chart segment between `ends` in the deepest of their home charts that
+/// holds both (by the smaller margin).
+fn deepest_midpoint(atlas: &charts::Atlas, ends: [ChartPoint; 2]) -> Option<ChartPoint> {
+    let margin = |chart: ChartId, w: Complex64| atlas.charts()[chart.index()].domain().margin(w);
+    ends.iter()
+        .filter_map(|home| {
+            let [wa, wc] = ends.map(|p| in_chart(atlas, p, home.chart));
+            let (wa, wc) = (wa?, wc?);
+            Some((margin(home.chart, wa).min(margin(home.chart, wc)), home.chart, wa, wc))
+        })
+        .max_by(|x, y| x.0.total_cmp(&y.0))
+        .map(|(_, chart, wa, wc)| ChartPoint::new(chart, 0.5 * (wa + wc)))
+}
+
 /// Whether the polygon turns left at every corner (strictly convex, counter-clockwise).
 fn convex(w: &[Complex64]) -> bool {
     let n = w.len();
@@ -262,7 +276,9 @@ fn split(
             ..QualityMesh::default()
         },
     };
-    // Each edge's midpoint, made by the first face that meets it, in that face's chart.
+    // Each edge's midpoint, in the deepest chart holding both ends (not the chart of whichever
+    // face meets the edge first: where a face is thin in its chart, a midpoint made in another
+    // chart can land on the wrong side of the centre).
     let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
     for face in faces {
         let n = face.corners.len();
@@ -273,8 +289,11 @@ fn split(
             let m = match midpoints.get(&key) {
                 Some(&m) => m,
                 None => {
+                    let ends = [a, c].map(|v| b.out.vertices[v as usize]);
                     let w = 0.5 * (face.coords[k] + face.coords[(k + 1) % n]);
-                    let m = b.vertex(ChartPoint::new(face.chart, w))?;
+                    let mid = deepest_midpoint(surface.atlas(), ends)
+                        .unwrap_or(ChartPoint::new(face.chart, w));
+                    let m = b.vertex(mid)?;
                     midpoints.insert(key, m);
                     m
                 }
