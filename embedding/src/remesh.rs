@@ -330,6 +330,16 @@ fn pinched(p: ChartPoint) -> EmbeddingError {
     ))
 }
 
+/// How one triangle lies, better to worse.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum FoldState {
+    Outward,
+    /// Counter-clockwise in its chart but facing away from the surface's normals.
+    FacingAway,
+    /// Clockwise in its chart, or held by no chart.
+    Turned,
+}
+
 /// Triangles that are turned over, or only lie badly.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct Folds {
@@ -532,15 +542,26 @@ impl Remesher<'_> {
             .all(|&i| n.dot(&self.verts[i as usize].normal) > 0.5 * len)
     }
 
+    /// How triangle `t` lies.
+    fn fold_state(&self, t: [u32; 3]) -> FoldState {
+        if !self.counter_clockwise(t) {
+            FoldState::Turned
+        } else if !self.faces_outward(t, t.map(|i| self.pos(i))) {
+            FoldState::FacingAway
+        } else {
+            FoldState::Outward
+        }
+    }
+
     /// How these triangles sit: how many wind clockwise in the chart holding them (or are held by
     /// none), and how many face away from the surface's normals at their corners.
     fn folds(&self, tris: impl Iterator<Item = [u32; 3]>) -> Folds {
         let mut f = Folds::default();
         for t in tris {
-            if !self.counter_clockwise(t) {
-                f.turned += 1;
-            } else if !self.faces_outward(t, t.map(|i| self.pos(i))) {
-                f.facing_away += 1;
+            match self.fold_state(t) {
+                FoldState::Turned => f.turned += 1,
+                FoldState::FacingAway => f.facing_away += 1,
+                FoldState::Outward => {}
             }
         }
         f
@@ -1248,20 +1269,68 @@ impl Remesher<'_> {
     }
 
     /// Sweeps moving each vertex part way towards the area-weighted centre of its triangles,
-    /// within its tangent plane, where no triangle around it turns over or comes to face away.
-    /// Each sweep finds every vertex's new place on all cores from the old places (Jacobi), then
-    /// moves them one by one, each where the triangles around it, as they are by then, allow.
+    /// within its tangent plane, where no triangle turns over or comes to face away. Each sweep
+    /// finds every vertex's new place from the old places (Jacobi) and makes all the moves at
+    /// once; then, until none is left, every triangle that came out worse than it was puts its
+    /// moved corners back. All on all cores but the moves themselves.
     fn smooth(&mut self, sweeps: usize) {
         // Moved corners make the chordal errors known so far stale.
         self.chordal_fine.clear();
         for _ in 0..sweeps {
-            let moved: Vec<Option<Vertex>> = (0..self.verts.len() as u32)
+            let targets: Vec<(u32, Vertex)> = (0..self.verts.len() as u32)
                 .into_par_iter()
-                .map(|v| self.relaxed(v, false))
+                .filter_map(|v| Some((v, self.relaxed(v, false)?)))
                 .collect();
-            for (v, moved) in moved.into_iter().enumerate() {
-                if let Some(moved) = moved {
-                    self.move_vertex(v as u32, moved);
+            let mut moved = vec![false; self.verts.len()];
+            for &(v, _) in &targets {
+                moved[v as usize] = true;
+            }
+            let around_moved = |r: &Self, moved: &[bool]| -> Vec<u32> {
+                (0..r.tris.len() as u32)
+                    .into_par_iter()
+                    .filter(|&t| {
+                        let tri = r.tris[t as usize];
+                        tri[0] != DEAD && tri.iter().any(|&i| moved[i as usize])
+                    })
+                    .collect()
+            };
+            let watched = around_moved(self, &moved);
+            let before: Vec<FoldState> = watched
+                .par_iter()
+                .map(|&t| self.fold_state(self.tris[t as usize]))
+                .collect();
+            let mut saved: Vec<Option<Vertex>> = vec![None; self.verts.len()];
+            for (v, target) in targets {
+                saved[v as usize] = Some(std::mem::replace(&mut self.verts[v as usize], target));
+            }
+            loop {
+                let worse: Vec<u32> = watched
+                    .par_iter()
+                    .zip(&before)
+                    .filter(|&(&t, &was)| self.fold_state(self.tris[t as usize]) > was)
+                    .map(|(&t, _)| t)
+                    .collect();
+                let mut put_back = 0;
+                for t in worse {
+                    for i in self.tris[t as usize] {
+                        if let Some(old) = saved[i as usize].take() {
+                            self.verts[i as usize] = old;
+                            moved[i as usize] = false;
+                            put_back += 1;
+                        }
+                    }
+                }
+                if put_back == 0 {
+                    break;
+                }
+            }
+            for (v, old) in saved.into_iter().enumerate() {
+                if let Some(old) = old {
+                    let new = &self.verts[v];
+                    let step = (new.pos - old.pos).norm();
+                    if step > MOVE_NOTICED * new.size || new.size != old.size {
+                        self.touch(v as u32);
+                    }
                 }
             }
         }
@@ -1304,23 +1373,6 @@ impl Remesher<'_> {
         let (ru, rv) = (vert.du.dot(&step), vert.dv.dot(&step));
         let dw = Complex64::new((g * ru - f * rv) / det, (e * rv - f * ru) / det);
         self.vertex(ChartPoint::new(vert.point.chart, vert.point.coords + dw))
-    }
-
-    /// Puts `v` at `moved` where that leaves the triangles around it no worse folded.
-    fn move_vertex(&mut self, v: u32, moved: Vertex) {
-        let around = |r: &Self| r.folds(r.ring(v).iter().map(|&t| r.tris[t as usize]));
-        let old_folds = around(self);
-        let step = (moved.pos - self.pos(v)).norm();
-        let noticed = step > MOVE_NOTICED * moved.size || moved.size != self.verts[v as usize].size;
-        let saved = std::mem::replace(&mut self.verts[v as usize], moved);
-        let new_folds = around(self);
-        if new_folds.no_worse_than(old_folds) {
-            if noticed {
-                self.touch(v);
-            }
-        } else {
-            self.verts[v as usize] = saved;
-        }
     }
 
     // ------------------------------------------------------------------ output

@@ -105,18 +105,6 @@ impl Jet {
         }
     }
 
-    /// c·self.
-    fn scaled(self, c: f64) -> Jet {
-        Jet {
-            val: c * self.val,
-            du: c * self.du,
-            dv: c * self.dv,
-            duu: c * self.duu,
-            duv: c * self.duv,
-            dvv: c * self.dvv,
-        }
-    }
-
     /// a / b by the quotient rule.
     fn quotient(a: Jet, b: Jet) -> Jet {
         let q = a.val / b.val;
@@ -408,20 +396,34 @@ impl<'a> Layout<'a> {
             add(&mut denominator, raw.through(d1, d2));
             let (fu, nu) = self.basis.eval(w.re, 2);
             let (fv, nv) = self.basis.eval(w.im, 2);
-            // E_c and its derivatives in its own chart's coordinates, one jet per coordinate.
-            let mut patch = [Jet::default(); 3];
+            // E_c and its derivatives in its own chart's coordinates: each row of control
+            // points summed along u first (value, ∂u, ∂uu), then the rows along v.
+            let zero = Vector3::zeros;
+            let (mut val, mut du, mut dv) = (zero(), zero(), zero());
+            let (mut duu, mut duv, mut dvv) = (zero(), zero(), zero());
             for j in 0..p1 {
+                let (mut row, mut row_u, mut row_uu) = (zero(), zero(), zero());
                 for i in 0..p1 {
-                    let basis = Jet::tensor(
-                        [nu[0][i], nu[1][i], nu[2][i]],
-                        [nv[0][j], nv[1][j], nv[2][j]],
-                    );
-                    let c = control[self.control_index(rep.chart, fu + i, fv + j)];
-                    for (k, e) in patch.iter_mut().enumerate() {
-                        add(e, basis.scaled(c[k]));
-                    }
+                    let c = control[self.control_index(rep.chart, fu + i, fv + j)].coords;
+                    row += c * nu[0][i];
+                    row_u += c * nu[1][i];
+                    row_uu += c * nu[2][i];
                 }
+                val += row * nv[0][j];
+                dv += row * nv[1][j];
+                dvv += row * nv[2][j];
+                du += row_u * nv[0][j];
+                duv += row_u * nv[1][j];
+                duu += row_uu * nv[0][j];
             }
+            let patch: [Jet; 3] = std::array::from_fn(|k| Jet {
+                val: val[k],
+                du: du[k],
+                dv: dv[k],
+                duu: duu[k],
+                duv: duv[k],
+                dvv: dvv[k],
+            });
             for (n, e) in numerator.iter_mut().zip(patch) {
                 add(n, Jet::product(raw, e).through(d1, d2));
             }

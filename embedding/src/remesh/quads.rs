@@ -165,7 +165,12 @@ fn deepest_midpoint(atlas: &charts::Atlas, ends: [ChartPoint; 2]) -> Option<Char
         .filter_map(|home| {
             let [wa, wc] = ends.map(|p| in_chart(atlas, p, home.chart));
             let (wa, wc) = (wa?, wc?);
-            Some((margin(home.chart, wa).min(margin(home.chart, wc)), home.chart, wa, wc))
+            Some((
+                margin(home.chart, wa).min(margin(home.chart, wc)),
+                home.chart,
+                wa,
+                wc,
+            ))
         })
         .max_by(|x, y| x.0.total_cmp(&y.0))
         .map(|(_, chart, wa, wc)| ChartPoint::new(chart, 0.5 * (wa + wc)))
