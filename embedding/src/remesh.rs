@@ -279,6 +279,7 @@ pub fn quality_mesh(
             r.smooth(1);
         }
     }
+    r.repeat(|r| r.collapse_tiny());
     r.repeat(|r| r.mend());
     r.finish()
 }
@@ -1096,6 +1097,22 @@ impl Remesher<'_> {
             .count();
         self.unfolded = false;
         count
+    }
+
+    /// Collapses edges shorter than the smallest target length, which bisecting bent edges at a
+    /// curvature spike can leave (their triangles there are caps and slivers too small for the
+    /// chordal error to matter).
+    fn collapse_tiny(&mut self) -> usize {
+        let tiny: Vec<(u32, u32)> = self
+            .edges()
+            .into_par_iter()
+            .filter(|&(a, b)| (self.pos(a) - self.pos(b)).norm() < self.min_edge)
+            .collect();
+        tiny.into_iter()
+            .filter(|&(a, b)| {
+                self.collapse(b, a, Purpose::Length) || self.collapse(a, b, Purpose::Length)
+            })
+            .count()
     }
 
     /// Whether moving `gone` onto `kept` would leave an edge from `kept` to one of `gone`'s
