@@ -13,7 +13,9 @@
 //! 3. split edges until every triangle's chordal error (the distance between the flat triangle's
 //!    centre and the surface point at its corners' mean chart coordinates) is within the
 //!    tolerance, then flip edges that are not locally Delaunay where that keeps the error;
-//! 4. mend what is left under 20° or over 150° by flips and collapses that keep the error.
+//! 4. collapse edges shorter than the smallest target length (bisection at a curvature spike
+//!    leaves caps below it), then mend what is left under 20° or over 150° by flips and
+//!    collapses that keep the error.
 //!
 //! Passes are incremental: after a pass over the whole mesh, the next looks only at the triangles
 //! around vertices the one before changed. The surface evaluations of a pass (midpoints, chordal
