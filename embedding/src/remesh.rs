@@ -1091,12 +1091,7 @@ impl Remesher<'_> {
                 .filter(|&(_, a, b)| !self.stretches(b, a) || !self.stretches(a, b))
                 .collect();
         }
-        let count = short
-            .into_iter()
-            .filter(|&(_, a, b)| {
-                self.collapse(b, a, Purpose::Length) || self.collapse(a, b, Purpose::Length)
-            })
-            .count();
+        let count = self.collapse_either_way(short.into_iter().map(|(_, a, b)| (a, b)));
         self.unfolded = false;
         count
     }
@@ -1110,7 +1105,13 @@ impl Remesher<'_> {
             .into_par_iter()
             .filter(|&(a, b)| (self.pos(a) - self.pos(b)).norm() < self.min_edge)
             .collect();
-        tiny.into_iter()
+        self.collapse_either_way(tiny.into_iter())
+    }
+
+    /// Collapses each edge that still exists when its turn comes, b onto a or else a onto b, for
+    /// its length; how many.
+    fn collapse_either_way(&mut self, edges: impl Iterator<Item = (u32, u32)>) -> usize {
+        edges
             .filter(|&(a, b)| {
                 self.collapse(b, a, Purpose::Length) || self.collapse(a, b, Purpose::Length)
             })
@@ -1304,16 +1305,14 @@ impl Remesher<'_> {
             for &(v, _) in &targets {
                 moved[v as usize] = true;
             }
-            let around_moved = |r: &Self, moved: &[bool]| -> Vec<u32> {
-                (0..r.tris.len() as u32)
-                    .into_par_iter()
-                    .filter(|&t| {
-                        let tri = r.tris[t as usize];
-                        tri[0] != DEAD && tri.iter().any(|&i| moved[i as usize])
-                    })
-                    .collect()
-            };
-            let watched = around_moved(self, &moved);
+            // The triangles a move can make worse: those with a moved corner.
+            let watched: Vec<u32> = (0..self.tris.len() as u32)
+                .into_par_iter()
+                .filter(|&t| {
+                    let tri = self.tris[t as usize];
+                    tri[0] != DEAD && tri.iter().any(|&i| moved[i as usize])
+                })
+                .collect();
             let before: Vec<FoldState> = watched
                 .par_iter()
                 .map(|&t| self.fold_state(self.tris[t as usize]))
@@ -1334,7 +1333,6 @@ impl Remesher<'_> {
                     for i in self.tris[t as usize] {
                         if let Some(old) = saved[i as usize].take() {
                             self.verts[i as usize] = old;
-                            moved[i as usize] = false;
                             put_back += 1;
                         }
                     }
