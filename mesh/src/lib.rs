@@ -7,6 +7,8 @@
 //! - [`cell_complex`] views a mesh as a cell complex with oriented 1-cells and validates one.
 //! - [`spatial`] checks triangle meshes in R³: exact self-intersections, degenerate triangles and
 //!   Hausdorff distances.
+//! - [`validate`] locates what the topology counts: the first non-manifold edge or vertex, the
+//!   boundary loops, where orientation breaks down, each face's component.
 //!
 //! ```
 //! use mesh::HalfEdgeMesh;
@@ -24,6 +26,7 @@ pub mod cell_complex;
 pub mod halfedge;
 pub mod shape;
 pub mod spatial;
+pub mod validate;
 
 pub use cell_complex::CellComplex;
 pub use halfedge::{HalfEdgeMesh, MeshError, Topology};
