@@ -1,8 +1,10 @@
 //! Everything ntori reads from or writes to files: atomic writes ([`atomic`]), model files
-//! ([`model_file`]) and mesh exports ([`export`], one file per format).
+//! ([`model_file`]), mesh exports ([`export`], one file per format) and users' meshes read and
+//! checked for a fit ([`import`], one file per format).
 //!
 //! Nothing here draws or edits; the formats' conventions live here and nowhere else.
 
 pub mod atomic;
 pub mod export;
+pub mod import;
 pub mod model_file;
