@@ -507,12 +507,12 @@ fn flatten(
     let mut used = lifts.relax(hyperbolic, sweeps, RELAX_TOLERANCE);
     for round in 2..=rounds {
         progress(FitStage::Relaxing { round, rounds });
-        let stretch = lifts.stretch(&disk, &positions, hyperbolic);
+        let stretch = lifts.stretch(&mesh.positions, hyperbolic);
         lifts.reweight(&stretch);
         used += lifts.relax(hyperbolic, sweeps, RELAX_TOLERANCE);
     }
     let sweeps = used;
-    let folded = lifts.folded_triangles(&disk, hyperbolic);
+    let folded = lifts.folded_triangles(hyperbolic);
     let copies = (0..disk.original.len() as u32)
         .map(|c| lifts.copy_position(&disk, c))
         .collect();
@@ -537,14 +537,18 @@ fn flatten(
 /// solves each side of a cut independently, so the flattening has a kink along every loop and a
 /// cone-like singularity at p₀; relaxing on the closed surface (every vertex to the mean value
 /// average of its neighbours, seen across the cuts through the side pairings) removes both.
-struct Lifts {
-    home: Vec<Complex64>,
+pub(crate) struct Lifts {
+    pub(crate) home: Vec<Complex64>,
     /// For each mesh vertex: its neighbours (weight, vertex, map from the neighbour's home lift
     /// into this vertex's frame).
-    neighbours: Vec<Vec<(f64, u32, Lft)>>,
-    /// For each disk copy: the group element taking its vertex's home lift onto it.
+    pub(crate) neighbours: Vec<Vec<(f64, u32, Lft)>>,
+    /// For each triangle: its corners' mesh vertices and the group elements taking their home lifts
+    /// into one frame where the triangle is whole.
+    pub(crate) corners: Vec<[(u32, Lft); 3]>,
+    /// For each disk copy: the group element taking its vertex's home lift onto it (empty where
+    /// the map was not made from a cut disk).
     to_copy: Vec<Lft>,
-    base: usize,
+    pub(crate) base: usize,
 }
 
 impl Lifts {
@@ -610,19 +614,41 @@ impl Lifts {
                 ));
             }
         }
+        let corners = disk
+            .triangles
+            .iter()
+            .map(|t| t.map(|c| (disk.original[c as usize], to_copy[c as usize])))
+            .collect();
         Ok(Lifts {
             home,
             neighbours,
+            corners,
             to_copy,
             base: mesh.base as usize,
         })
+    }
+
+    /// Lifts from their parts, for maps not made from a cut disk.
+    pub(crate) fn from_parts(
+        home: Vec<Complex64>,
+        neighbours: Vec<Vec<(f64, u32, Lft)>>,
+        corners: Vec<[(u32, Lft); 3]>,
+        base: usize,
+    ) -> Lifts {
+        Lifts {
+            home,
+            neighbours,
+            corners,
+            to_copy: Vec::new(),
+            base,
+        }
     }
 
     /// Over-relaxed Gauss–Seidel sweeps of the mean value average, taken in each vertex's own frame
     /// (the isometry moving it to the origin, where the Poincaré disk is conformal to the plane),
     /// until no vertex moves by more than `tolerance` (in frame units) in a sweep, or `sweeps` run
     /// out. Returns the sweeps used.
-    fn relax(&mut self, hyperbolic: bool, sweeps: usize, tolerance: f64) -> usize {
+    pub(crate) fn relax(&mut self, hyperbolic: bool, sweeps: usize, tolerance: f64) -> usize {
         // Over-relaxation speeds the slow global modes up (1.3 is stable at every genus tried; 1.6
         // diverges at genus 8); the step is capped so that no vertex jumps out of its neighbourhood
         // (a step of length ≥ 1 would leave the disk).
@@ -674,27 +700,24 @@ impl Lifts {
         sweeps
     }
 
-    /// Disk triangles whose lifted corners are not counter-clockwise (hyperbolic or Euclidean area
-    /// ≤ 0): a relaxed map that is a bijection has none.
     /// Per mesh vertex: √(3D area / model area) of its triangles, relative to the whole surface's
     /// ratio (1 where the map shrinks the surface by the average amount).
-    fn stretch(&self, disk: &CutDisk, positions: &[Point3], hyperbolic: bool) -> Vec<f64> {
+    pub(crate) fn stretch(&self, positions: &[Point3], hyperbolic: bool) -> Vec<f64> {
         let n = self.home.len();
         let (mut surface, mut model) = (vec![0.0; n], vec![0.0; n]);
-        for t in &disk.triangles {
-            let [a, b, c] = t.map(|v| positions[v as usize]);
+        for t in &self.corners {
+            let [a, b, c] = t.map(|(v, _)| positions[v as usize]);
             let area3 = (b - a).cross(&(c - a)).norm() / 2.0;
-            let z = t.map(|v| self.copy_position(disk, v));
+            let z = self.corner_positions(t);
             let area2 = if hyperbolic {
                 charts::hyperbolic_area(z)
             } else {
                 0.5 * ((z[1] - z[0]).conj() * (z[2] - z[0])).im
             }
             .max(0.0);
-            for &v in t {
-                let o = disk.original[v as usize] as usize;
-                surface[o] += area3;
-                model[o] += area2;
+            for &(o, _) in t {
+                surface[o as usize] += area3;
+                model[o as usize] += area2;
             }
         }
         let ratio = surface.iter().sum::<f64>() / model.iter().sum::<f64>();
@@ -712,7 +735,7 @@ impl Lifts {
     /// Yoshizawa, Belyaev and Seidel's stretch-minimizing update, damped: each weight w_vu is divided
     /// by a power of the stretch at u, so where the map squeezes the surface the neighbourhood opens
     /// up. Weights stay positive, so the map stays a bijection.
-    fn reweight(&mut self, stretch: &[f64]) {
+    pub(crate) fn reweight(&mut self, stretch: &[f64]) {
         for list in &mut self.neighbours {
             for (w, u, _) in list.iter_mut() {
                 *w /= stretch[*u as usize].powf(STRETCH_EXPONENT);
@@ -720,17 +743,24 @@ impl Lifts {
         }
     }
 
+    /// A disk copy's position: its vertex's home lift carried onto the copy.
     fn copy_position(&self, disk: &CutDisk, c: u32) -> Complex64 {
         let o = disk.original[c as usize];
         self.to_copy[c as usize].apply(self.home[o as usize])
     }
 
-    fn folded_triangles(&self, disk: &CutDisk, hyperbolic: bool) -> usize {
-        let at = |c: u32| self.copy_position(disk, c);
-        disk.triangles
+    /// A triangle's corners in its frame.
+    fn corner_positions(&self, t: &[(u32, Lft); 3]) -> [Complex64; 3] {
+        t.map(|(v, g)| g.apply(self.home[v as usize]))
+    }
+
+    /// Triangles whose lifted corners are not counter-clockwise (hyperbolic or Euclidean area ≤ 0):
+    /// a relaxed map that is a bijection has none.
+    pub(crate) fn folded_triangles(&self, hyperbolic: bool) -> usize {
+        self.corners
             .iter()
             .filter(|t| {
-                let p = t.map(at);
+                let p = self.corner_positions(t);
                 let area = if hyperbolic {
                     charts::hyperbolic_area(p)
                 } else {
@@ -756,7 +786,7 @@ fn corner_maps(polygon: &Polygon) -> Vec<Lft> {
 }
 
 /// The representation of a model point that lies deepest inside its chart.
-fn deepest(atlas: &Atlas, z: ModelPoint) -> Result<ChartPoint, EmbeddingError> {
+pub(crate) fn deepest(atlas: &Atlas, z: ModelPoint) -> Result<ChartPoint, EmbeddingError> {
     let m = atlas.locate_model(z);
     m.representations()
         .iter()

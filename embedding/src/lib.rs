@@ -28,6 +28,7 @@ pub mod fit;
 pub mod floater;
 pub mod holed;
 pub mod integrals;
+pub mod mesh_fit;
 pub mod model;
 pub mod quality;
 pub mod remesh;

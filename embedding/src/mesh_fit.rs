@@ -1,0 +1,307 @@
+//! Fitting a user's mesh: any closed, oriented, manifold triangle mesh of genus 1 to 64 becomes a
+//! model, through the same relaxation, checks and least-squares fit as [`crate::fit`]'s plates.
+//!
+//! A plate comes with its canonical loops; a user's mesh does not. Instead of cutting the mesh along
+//! canonical loops (which would have to be found, re-routed and made disjoint on the mesh), the map is
+//! built from the loops' *holonomy*: which deck transformation of the polygon tiling each edge crosses.
+//!
+//! 1. A greedy system of loops through a base vertex ([`mesh::schema::loop_system`]): a shortest-path
+//!    tree, a dual tree, and 2g generator edges, with the relation the cut disk's boundary reads.
+//! 2. That relation is brought to canonical form on words ([`mesh::schema::canonicalize`]); the
+//!    canonical letters a_k, b_k go to the polygon's pairings (see [`canonical_element`]), which
+//!    satisfy ∏[a_k, b_k] = 1, so each generator edge gets its word's group element (shortened by
+//!    Dehn's algorithm first, so the products stay well conditioned).
+//! 3. Tree edges carry the identity; the dual tree's edges follow from flatness (each triangle's
+//!    three elements multiply to the identity), peeled from the leaves. The last triangle checks the
+//!    relation numerically.
+//! 4. Every vertex gets a lift in the Poincaré disk (the plane for the torus) and is relaxed to the
+//!    mean value average of its neighbours seen through those elements: an equivariant Tutte map,
+//!    which is a bijection onto the surface for positive weights. Then the plates' stretch
+//!    reweighting, the fold count and the least-squares fit run unchanged.
+//!
+//! The polygon's sides pulled back by the map are a canonical system of loops on the surface, and
+//! the marking it defines is what the canonical words say; no loop is cut into the mesh.
+
+use std::sync::Arc;
+
+use charts::{Atlas, Lft, ModelPoint, Polygon};
+use mesh::HalfEdgeMesh;
+use mesh::schema::{self, EdgeRole, Letter, LoopSystem};
+use num_complex::Complex64;
+
+use crate::fit::{
+    FitSettings, FitStage, Lifts, Parameterization, RELAX_TOLERANCE, deepest, diagonal, fit,
+    vertex_areas,
+};
+use crate::spline_surface::Surface;
+use crate::surface::{Layout, Point3, SplineSettings};
+use crate::{EmbeddingError, floater};
+
+/// A model fitted to a user's mesh, and how well it fits.
+#[derive(Clone, Debug)]
+pub struct MeshFit {
+    pub surface: Surface,
+    pub genus: u32,
+    /// The mesh's vertices' surface points (one per vertex), the relaxation's sweeps and folds.
+    pub parameterization: Parameterization,
+    /// The loop system the map was built from.
+    pub loops: LoopReport,
+    /// Root mean square and largest distance |S(p_i) − P_i| over the mesh vertices.
+    pub rms_residual: f64,
+    pub max_residual: f64,
+    /// The input mesh's bounding-box diagonal.
+    pub mesh_diagonal: f64,
+}
+
+/// The greedy loops and their canonical form.
+#[derive(Clone, Debug)]
+pub struct LoopReport {
+    pub base: u32,
+    /// Each generator's loop as a closed vertex path from the base.
+    pub paths: Vec<Vec<u32>>,
+    /// The relation the cut disk's boundary reads, in the generators.
+    pub relation: schema::Word,
+    /// Each generator as a word in the canonical letters (2k = a_k, 2k + 1 = b_k).
+    pub canonical: Vec<schema::Word>,
+    /// The largest distance of the last triangle's product of elements from the identity: the
+    /// relation checked numerically.
+    pub closure_error: f64,
+}
+
+/// Candidate base vertices tried: the one whose generator loops are shortest in total is used.
+const BASE_CANDIDATES: usize = 6;
+
+/// Fits a model to a closed, oriented, manifold, connected triangle mesh of genus ≥ 1 (counter-
+/// clockwise seen from outside). Refuses more than [`crate::fit::MAX_FIT_TRIANGLES`] triangles.
+pub fn mesh_model(
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    settings: SplineSettings,
+    fit_settings: FitSettings,
+    progress: &dyn Fn(FitStage),
+) -> Result<MeshFit, EmbeddingError> {
+    let fail = |what: String| EmbeddingError::Parameterization(what);
+    progress(FitStage::Flattening);
+    let he = HalfEdgeMesh::from_polygons(positions.len(), triangles.iter().map(|t| &t[..]))
+        .map_err(|e| fail(e.to_string()))?;
+    let topology = he.topology();
+    if !(topology.closed && topology.manifold && topology.orientable && topology.components == 1)
+        || topology.misoriented_edges > 0
+    {
+        return Err(fail(
+            "the mesh must be closed, manifold, consistently oriented and connected".into(),
+        ));
+    }
+    let genus = topology
+        .genus
+        .ok_or_else(|| fail("the mesh has no genus".into()))?;
+    if genus == 0 {
+        return Err(fail("genus 0 meshes are not fitted yet".into()));
+    }
+    let atlas = Arc::new(Atlas::new(genus)?);
+    let layout = Layout::new(&atlas, settings)?;
+    let polygon = atlas.polygon().expect("genus ≥ 1 has a polygon");
+    let hyperbolic = genus >= 2;
+
+    let length = |h: u32| (positions[he.target(h) as usize] - positions[he.origin(h) as usize]).norm();
+    let system = shortest_system(&he, &length)?;
+    let canonical = schema::canonicalize(&system.relation, system.generators.len())
+        .map_err(|e| fail(e.to_string()))?;
+    let words: Vec<schema::Word> = canonical
+        .originals
+        .iter()
+        .map(|w| schema::dehn_reduce(w, genus as usize))
+        .collect();
+    let (holonomy, closure_error) = holonomy(&he, &system, polygon, &words)?;
+
+    let mut lifts = equivariant_lifts(&he, positions, triangles, &holonomy, system.base)?;
+    let rounds = fit_settings.stretch_rounds + 1;
+    let mut sweeps = 0;
+    for round in 1..=rounds {
+        progress(FitStage::Relaxing { round, rounds });
+        if round > 1 {
+            let stretch = lifts.stretch(positions, hyperbolic);
+            lifts.reweight(&stretch);
+        }
+        sweeps += lifts.relax(hyperbolic, fit_settings.sweeps, RELAX_TOLERANCE);
+    }
+    let folded = lifts.folded_triangles(hyperbolic);
+    let points = lifts
+        .home
+        .iter()
+        .map(|&z| deepest(&atlas, ModelPoint(z)))
+        .collect::<Result<Vec<_>, _>>()?;
+
+    progress(FitStage::Fitting);
+    let weights = vertex_areas(positions, triangles);
+    let control = fit(&layout, &points, positions, &weights, fit_settings)?;
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for (p, target) in points.iter().zip(positions) {
+        let e = (layout.eval(&control, *p).pos - target).norm();
+        sum += e * e;
+        max = max.max(e);
+    }
+    let surface = Surface::new(Arc::clone(&atlas), settings, control)?;
+    let loops = LoopReport {
+        base: system.base,
+        paths: (0..system.generators.len())
+            .map(|i| system.loop_path(&he, i))
+            .collect(),
+        relation: system.relation.clone(),
+        canonical: words,
+        closure_error,
+    };
+    Ok(MeshFit {
+        surface,
+        genus,
+        parameterization: Parameterization {
+            points,
+            disk: None,
+            flat: Vec::new(),
+            lifts: lifts.home,
+            copies: Vec::new(),
+            folded,
+            sweeps,
+        },
+        loops,
+        rms_residual: (sum / positions.len() as f64).sqrt(),
+        max_residual: max,
+        mesh_diagonal: diagonal(positions),
+    })
+}
+
+/// The loop system through the best of a few well-spread base vertices (farthest-point samples
+/// along the mesh): the one whose generator loops are shortest in total.
+pub fn shortest_system(
+    he: &HalfEdgeMesh,
+    length: &impl Fn(u32) -> f64,
+) -> Result<LoopSystem, EmbeddingError> {
+    let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
+    let mut best: Option<(f64, LoopSystem)> = None;
+    let mut nearest = vec![f64::INFINITY; he.vertex_count()];
+    let mut base = 0u32;
+    for _ in 0..BASE_CANDIDATES.min(he.vertex_count()) {
+        let system = schema::loop_system(he, length, base).map_err(fail)?;
+        let total: f64 = system
+            .generators
+            .iter()
+            .map(|&h| {
+                system.distance[he.origin(h) as usize]
+                    + length(h)
+                    + system.distance[he.target(h) as usize]
+            })
+            .sum();
+        for (n, d) in nearest.iter_mut().zip(&system.distance) {
+            *n = n.min(*d);
+        }
+        if best.as_ref().is_none_or(|(t, _)| total < *t) {
+            best = Some((total, system));
+        }
+        base = (0..nearest.len())
+            .max_by(|&a, &b| nearest[a].total_cmp(&nearest[b]))
+            .unwrap_or(0) as u32;
+    }
+    Ok(best.expect("at least one candidate").1)
+}
+
+/// The group element of canonical letter 2k + t. The polygon's pairings A_k = cross(4k) and
+/// B_k = cross(4k + 3) satisfy ∏[A_k, B_k] = 1 composed left to right, but read round a counter-
+/// clockwise disk they make the mirror image; so a_k ↦ B_{g−1−k} and b_k ↦ A_{g−1−k}, which satisfy
+/// ∏[a_k, b_k] = (∏[A_k, B_k])⁻¹ = 1 and keep the orientation (checked by the tests).
+pub fn canonical_element(polygon: &Polygon, letter: Letter) -> Lft {
+    let (k, t) = (letter.generator as usize / 2, letter.generator % 2);
+    let handle = polygon.genus() as usize - 1 - k;
+    let side = if t == 0 { 4 * handle + 3 } else { 4 * handle };
+    let g = *polygon.cross(side);
+    if letter.inverse { g.inverse() } else { g }
+}
+
+/// A word's group element, composed left to right (a path's elements in the order it crosses).
+pub fn word_element(polygon: &Polygon, word: &[Letter]) -> Lft {
+    word.iter().fold(Lft::IDENTITY, |acc, &l| {
+        acc.compose(&canonical_element(polygon, l))
+    })
+}
+
+/// Per half-edge u → v: the element g with v's lift seen from u's frame at g·lift(v). Tree edges carry
+/// the identity, generators their canonical words, cotree edges what flatness leaves them. Returns
+/// also how far the last triangle's product is from the identity.
+fn holonomy(
+    he: &HalfEdgeMesh,
+    system: &LoopSystem,
+    polygon: &Polygon,
+    words: &[schema::Word],
+) -> Result<(Vec<Lft>, f64), EmbeddingError> {
+    let mut g = vec![Lft::IDENTITY; he.halfedge_count()];
+    for (h, role) in system.roles.iter().enumerate() {
+        if let EdgeRole::Generator { index, forward } = *role {
+            let element = word_element(polygon, &words[index as usize]);
+            g[h] = if forward { element } else { element.inverse() };
+        }
+    }
+    for &h in &system.peel {
+        let (n1, n2) = (he.next(h), he.next(he.next(h)));
+        let solved = g[n1 as usize].compose(&g[n2 as usize]).inverse();
+        g[h as usize] = solved;
+        let t = he.twin(h).expect("closed");
+        g[t as usize] = solved.inverse();
+    }
+    let root = he.face_halfedges(system.root_face);
+    let product = root.fold(Lft::IDENTITY, |acc, h| acc.compose(&g[h as usize]));
+    let closure_error = product.distance(&Lft::IDENTITY);
+    if closure_error.is_nan() || closure_error > 1e-6 {
+        return Err(EmbeddingError::Parameterization(format!(
+            "the loops' holonomy does not close (off by {closure_error:.1e}): the relation is not the surface's"
+        )));
+    }
+    Ok((g, closure_error))
+}
+
+/// The relaxation's starting lifts (every vertex at the origin), mean value weights, and each
+/// triangle's corners in its first corner's frame.
+fn equivariant_lifts(
+    he: &HalfEdgeMesh,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    holonomy: &[Lft],
+    base: u32,
+) -> Result<Lifts, EmbeddingError> {
+    let outgoing = he.outgoing();
+    let halfedge = |v: u32, u: u32| {
+        outgoing[v as usize]
+            .iter()
+            .copied()
+            .find(|&h| he.target(h) == u)
+            .expect("neighbours share an edge")
+    };
+    let weights = floater::mean_value_weights(positions, triangles)?;
+    let neighbours = weights
+        .iter()
+        .enumerate()
+        .map(|(v, list)| {
+            list.iter()
+                .map(|&(u, w)| (w, u, holonomy[halfedge(v as u32, u) as usize]))
+                .collect()
+        })
+        .collect();
+    let corners = (0..he.face_count() as u32)
+        .map(|f| {
+            let [h0, h1, h2] = {
+                let mut hs = he.face_halfedges(f);
+                [hs.next(), hs.next(), hs.next()].map(|h| h.expect("triangles"))
+            };
+            let (g0, g1) = (holonomy[h0 as usize], holonomy[h1 as usize]);
+            [
+                (he.origin(h0), Lft::IDENTITY),
+                (he.origin(h1), g0),
+                (he.origin(h2), g0.compose(&g1)),
+            ]
+        })
+        .collect();
+    Ok(Lifts::from_parts(
+        vec![Complex64::ZERO; positions.len()],
+        neighbours,
+        corners,
+        base as usize,
+    ))
+}
