@@ -26,6 +26,7 @@ pub mod cell_complex;
 pub mod halfedge;
 pub mod shape;
 pub mod spatial;
+pub mod schema;
 pub mod validate;
 
 pub use cell_complex::CellComplex;
