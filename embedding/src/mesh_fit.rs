@@ -12,8 +12,8 @@
 //!    satisfy ∏[a_k, b_k] = 1, so each generator edge gets its word's group element (shortened by
 //!    Dehn's algorithm first, so the products stay well conditioned).
 //! 3. Tree edges carry the identity; the dual tree's edges follow from flatness (each triangle's
-//!    three elements multiply to the identity), peeled from the leaves. The last triangle checks the
-//!    relation numerically.
+//!    three elements multiply to the identity), peeled from the leaves, on words
+//!    ([`mesh::schema::edge_words`]). The last triangle checks the relation exactly.
 //! 4. Every vertex gets a lift in the Poincaré disk (the plane for the torus) and is relaxed to the
 //!    mean value average of its neighbours seen through those elements: an equivariant Tutte map,
 //!    which is a bijection onto the surface for positive weights. Then the plates' stretch
@@ -26,7 +26,7 @@ use std::sync::Arc;
 
 use charts::{Atlas, Lft, ModelPoint, Polygon};
 use mesh::HalfEdgeMesh;
-use mesh::schema::{self, EdgeRole, Letter, LoopSystem};
+use mesh::schema::{self, Letter, LoopSystem};
 use num_complex::Complex64;
 
 use crate::fit::{
@@ -63,8 +63,8 @@ pub struct LoopReport {
     pub relation: schema::Word,
     /// Each generator as a word in the canonical letters (2k = a_k, 2k + 1 = b_k).
     pub canonical: Vec<schema::Word>,
-    /// The largest distance of the last triangle's product of elements from the identity: the
-    /// relation checked numerically.
+    /// The largest distance of a triangle's product of elements from the identity (rounding only:
+    /// the words are checked exactly).
     pub closure_error: f64,
 }
 
@@ -103,18 +103,14 @@ pub fn mesh_model(
     let polygon = atlas.polygon().expect("genus ≥ 1 has a polygon");
     let hyperbolic = genus >= 2;
 
-    let length = |h: u32| (positions[he.target(h) as usize] - positions[he.origin(h) as usize]).norm();
-    let system = shortest_system(&he, &length)?;
-    let canonical = schema::canonicalize(&system.relation, system.generators.len())
-        .map_err(|e| fail(e.to_string()))?;
-    let words: Vec<schema::Word> = canonical
-        .originals
-        .iter()
-        .map(|w| schema::dehn_reduce(w, genus as usize))
-        .collect();
-    let (holonomy, closure_error) = holonomy(&he, &system, polygon, &words)?;
-
-    let mut lifts = equivariant_lifts(&he, positions, triangles, &holonomy, system.base)?;
+    let length =
+        |h: u32| (positions[he.target(h) as usize] - positions[he.origin(h) as usize]).norm();
+    let Marked {
+        system,
+        words,
+        closure_error,
+        mut lifts,
+    } = best_marking(&he, positions, triangles, polygon, &length)?;
     let rounds = fit_settings.stretch_rounds + 1;
     let mut sweeps = 0;
     for round in 1..=rounds {
@@ -170,38 +166,76 @@ pub fn mesh_model(
     })
 }
 
-/// The loop system through the best of a few well-spread base vertices (farthest-point samples
-/// along the mesh): the one whose generator loops are shortest in total.
-pub fn shortest_system(
+/// A loop system through one base vertex, its canonical words, and the relaxed map they define.
+struct Marked {
+    system: LoopSystem,
+    words: Vec<schema::Word>,
+    closure_error: f64,
+    lifts: Lifts,
+}
+
+/// The marking (which loop becomes which side of the polygon) decides the map: the harmonic map of
+/// a marking twisted round a handle squeezes that handle. Markings from a few well-spread base
+/// vertices (farthest-point samples along the mesh) are relaxed for [`SCREEN_SWEEPS`] sweeps each,
+/// and the one whose map stretches the surface most evenly is kept.
+fn best_marking(
     he: &HalfEdgeMesh,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    polygon: &Polygon,
     length: &impl Fn(u32) -> f64,
-) -> Result<LoopSystem, EmbeddingError> {
+) -> Result<Marked, EmbeddingError> {
     let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
-    let mut best: Option<(f64, LoopSystem)> = None;
+    let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
+    let genus = polygon.genus() as usize;
+    let areas = vertex_areas(positions, triangles);
+    let mut best: Option<(f64, Marked)> = None;
     let mut nearest = vec![f64::INFINITY; he.vertex_count()];
     let mut base = 0u32;
     for _ in 0..BASE_CANDIDATES.min(he.vertex_count()) {
         let system = schema::loop_system(he, length, base).map_err(fail)?;
-        let total: f64 = system
-            .generators
-            .iter()
-            .map(|&h| {
-                system.distance[he.origin(h) as usize]
-                    + length(h)
-                    + system.distance[he.target(h) as usize]
-            })
-            .sum();
         for (n, d) in nearest.iter_mut().zip(&system.distance) {
             *n = n.min(*d);
-        }
-        if best.as_ref().is_none_or(|(t, _)| total < *t) {
-            best = Some((total, system));
         }
         base = (0..nearest.len())
             .max_by(|&a, &b| nearest[a].total_cmp(&nearest[b]))
             .unwrap_or(0) as u32;
+        let canonical =
+            schema::canonicalize(&system.relation, system.generators.len()).map_err(fail)?;
+        let words: Vec<schema::Word> = canonical
+            .originals
+            .iter()
+            .map(|w| schema::dehn_reduce(w, genus))
+            .collect();
+        let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
+        let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
+        lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
+        let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), &areas);
+        if best.as_ref().is_none_or(|(s, _)| score < *s) {
+            let marked = Marked {
+                system,
+                words,
+                closure_error,
+                lifts,
+            };
+            best = Some((score, marked));
+        }
     }
     Ok(best.expect("at least one candidate").1)
+}
+
+/// Sweeps each candidate marking is relaxed for before they are compared.
+const SCREEN_SWEEPS: usize = 300;
+
+/// The area-weighted mean of (ln stretch)²: 0 for a map that shrinks the surface evenly.
+fn uneven_stretch(stretch: &[f64], areas: &[f64]) -> f64 {
+    let total: f64 = areas.iter().sum();
+    stretch
+        .iter()
+        .zip(areas)
+        .map(|(s, a)| a * s.ln().powi(2))
+        .sum::<f64>()
+        / total
 }
 
 /// The group element of canonical letter 2k + t. The polygon's pairings A_k = cross(4k) and
@@ -223,37 +257,28 @@ pub fn word_element(polygon: &Polygon, word: &[Letter]) -> Lft {
     })
 }
 
-/// Per half-edge u → v: the element g with v's lift seen from u's frame at g·lift(v). Tree edges carry
-/// the identity, generators their canonical words, cotree edges what flatness leaves them. Returns
-/// also how far the last triangle's product is from the identity.
+/// Per half-edge u → v: the element g with v's lift seen from u's frame at g·lift(v), from the
+/// edges' words ([`schema::edge_words`]). Returns also how far each triangle's product is from the
+/// identity at most, in f64.
 fn holonomy(
     he: &HalfEdgeMesh,
     system: &LoopSystem,
     polygon: &Polygon,
     words: &[schema::Word],
 ) -> Result<(Vec<Lft>, f64), EmbeddingError> {
-    let mut g = vec![Lft::IDENTITY; he.halfedge_count()];
-    for (h, role) in system.roles.iter().enumerate() {
-        if let EdgeRole::Generator { index, forward } = *role {
-            let element = word_element(polygon, &words[index as usize]);
-            g[h] = if forward { element } else { element.inverse() };
-        }
-    }
-    for &h in &system.peel {
-        let (n1, n2) = (he.next(h), he.next(he.next(h)));
-        let solved = g[n1 as usize].compose(&g[n2 as usize]).inverse();
-        g[h as usize] = solved;
-        let t = he.twin(h).expect("closed");
-        g[t as usize] = solved.inverse();
-    }
-    let root = he.face_halfedges(system.root_face);
-    let product = root.fold(Lft::IDENTITY, |acc, h| acc.compose(&g[h as usize]));
-    let closure_error = product.distance(&Lft::IDENTITY);
-    if closure_error.is_nan() || closure_error > 1e-6 {
-        return Err(EmbeddingError::Parameterization(format!(
-            "the loops' holonomy does not close (off by {closure_error:.1e}): the relation is not the surface's"
-        )));
-    }
+    let edge_words = schema::edge_words(he, system, words, polygon.genus() as usize)
+        .map_err(|e| EmbeddingError::Parameterization(e.to_string()))?;
+    let g: Vec<Lft> = edge_words
+        .iter()
+        .map(|w| word_element(polygon, w))
+        .collect();
+    let closure_error = (0..he.face_count() as u32)
+        .map(|f| {
+            he.face_halfedges(f)
+                .fold(Lft::IDENTITY, |acc, h| acc.compose(&g[h as usize]))
+                .distance(&Lft::IDENTITY)
+        })
+        .fold(0.0, f64::max);
     Ok((g, closure_error))
 }
 

@@ -151,7 +151,8 @@ pub fn loop_system(
     let mut candidates: Vec<(f64, u32)> = (0..h_count as u32)
         .filter(|&h| roles[h as usize] != EdgeRole::Tree && h < mesh.twin(h).unwrap_or(0))
         .map(|h| {
-            let d = distance[mesh.origin(h) as usize] + length(h) + distance[mesh.target(h) as usize];
+            let d =
+                distance[mesh.origin(h) as usize] + length(h) + distance[mesh.target(h) as usize];
             (d, h)
         })
         .collect();
@@ -389,7 +390,9 @@ pub fn cyclic_reduce(w: &[Letter]) -> Word {
 /// Whether two words are equal as cyclic words (after cyclic reduction).
 pub fn cyclically_equal(a: &[Letter], b: &[Letter]) -> bool {
     let (a, b) = (cyclic_reduce(a), cyclic_reduce(b));
-    a.len() == b.len() && (a.is_empty() || (0..a.len()).any(|s| (0..a.len()).all(|i| a[(i + s) % a.len()] == b[i])))
+    a.len() == b.len()
+        && (a.is_empty()
+            || (0..a.len()).any(|s| (0..a.len()).all(|i| a[(i + s) % a.len()] == b[i])))
 }
 
 /// `word` with each generator i replaced by `images[i]`, freely reduced.
@@ -426,20 +429,26 @@ pub fn canonicalize(relation: &[Letter], generators: usize) -> Result<Canonical,
         }
     }
     if generators % 2 != 0 || uses.iter().any(|u| *u != [1, 1]) {
-        return Err(bad("the relation does not use every generator once each way"));
+        return Err(bad(
+            "the relation does not use every generator once each way",
+        ));
     }
     // originals[i]: original generator i in the current letters (which reuse the indices).
     let mut originals: Vec<Word> = (0..generators as u32).map(|g| vec![letter(g)]).collect();
     let mut finished = vec![false; generators];
     for _ in 0..generators / 2 {
-        let step = tightest_pair(&word, &finished).ok_or_else(|| bad("a letter is linked with no other"))?;
+        let step = tightest_pair(&word, &finished)
+            .ok_or_else(|| bad("a letter is linked with no other"))?;
         word.rotate_left(step.rotation);
         let (a, b) = (step.a, step.b);
         if word[0].inverse {
             flip(&mut word, &mut originals, a);
         }
         let a_back = position(&word, a, true);
-        let b_first = word.iter().position(|l| l.generator == b).expect("b occurs");
+        let b_first = word
+            .iter()
+            .position(|l| l.generator == b)
+            .expect("b occurs");
         if word[b_first].inverse {
             flip(&mut word, &mut originals, b);
         }
@@ -505,7 +514,10 @@ fn tightest_pair(word: &[Letter], finished: &[bool]) -> Option<Step> {
         if finished[a] {
             continue;
         }
-        for (i, j) in [(occurrences[0], occurrences[1]), (occurrences[1], occurrences[0])] {
+        for (i, j) in [
+            (occurrences[0], occurrences[1]),
+            (occurrences[1], occurrences[0]),
+        ] {
             let rot = |x: usize| (x + n - i) % n;
             let j = rot(j);
             for (b, other) in at.iter().enumerate() {
@@ -571,9 +583,27 @@ fn replace(originals: &mut [Word], g: u32, image: &[Letter]) {
 /// Dehn's algorithm for the surface group ⟨a₁, b₁, … | ∏[a_k, b_k]⟩ (genus ≥ 2): while the word
 /// holds more than half of a cyclic rotation of the relator or its inverse, replace that part by the
 /// inverse of the rest. The result is shorter, equal in the group, and (by small cancellation
-/// theory) empty exactly when the word is the identity.
+/// theory: pieces have length 1, under a sixth of the relator's 4g) empty exactly when the word is
+/// the identity. Genus 1's group is Z², where the word becomes a^m b^n.
 pub fn dehn_reduce(word: &[Letter], genus: usize) -> Word {
     let mut w = free_reduce(word);
+    if genus == 1 {
+        // Z²: a^m b^n.
+        let power = |g: u32| {
+            w.iter()
+                .filter(|l| l.generator == g)
+                .map(|l| if l.inverse { -1i64 } else { 1 })
+                .sum::<i64>()
+        };
+        let repeat = |g: u32, n: i64| {
+            let l = Letter {
+                generator: g,
+                inverse: n < 0,
+            };
+            std::iter::repeat_n(l, n.unsigned_abs() as usize)
+        };
+        return repeat(0, power(0)).chain(repeat(1, power(1))).collect();
+    }
     if genus < 2 {
         return w;
     }
@@ -597,11 +627,7 @@ pub fn dehn_reduce(word: &[Letter], genus: usize) -> Word {
     'outer: loop {
         for start in 0..w.len() {
             for r in &rotations {
-                let matched = w[start..]
-                    .iter()
-                    .zip(r)
-                    .take_while(|(x, y)| x == y)
-                    .count();
+                let matched = w[start..].iter().zip(r).take_while(|(x, y)| x == y).count();
                 if 2 * matched > len {
                     let rest = inverse(&r[matched..]);
                     let mut next = w[..start].to_vec();
@@ -614,4 +640,45 @@ pub fn dehn_reduce(word: &[Letter], genus: usize) -> Word {
         }
         return w;
     }
+}
+
+/// Per half-edge u → v: the word of the group element that carries v's lift into u's frame, in the
+/// canonical letters, with `words[i]` on generator i's edge, the empty word on tree edges, and the
+/// cotree edges solved so that every triangle's three words multiply to the identity. Worked out on
+/// words (each reduced by [`dehn_reduce`]), not on matrices: a chain of products along the dual tree
+/// loses every digit at genus 8, while the words of short loops stay short. The last triangle's
+/// product must reduce to the empty word, which checks the relation exactly.
+pub fn edge_words(
+    mesh: &HalfEdgeMesh,
+    system: &LoopSystem,
+    words: &[Word],
+    genus: usize,
+) -> Result<Vec<Word>, SchemaError> {
+    let mut out = vec![Vec::new(); mesh.halfedge_count()];
+    for (h, role) in system.roles.iter().enumerate() {
+        if let EdgeRole::Generator { index, forward } = *role {
+            let w = &words[index as usize];
+            out[h] = if forward { w.clone() } else { inverse(w) };
+        }
+    }
+    for &h in &system.peel {
+        let (n1, n2) = (mesh.next(h), mesh.next(mesh.next(h)));
+        let solved = dehn_reduce(
+            &inverse(&[&out[n1 as usize][..], &out[n2 as usize][..]].concat()),
+            genus,
+        );
+        let t = mesh.twin(h).expect("closed: checked by loop_system");
+        out[t as usize] = inverse(&solved);
+        out[h as usize] = solved;
+    }
+    let around: Word = mesh
+        .face_halfedges(system.root_face)
+        .flat_map(|h| out[h as usize].clone())
+        .collect();
+    if !dehn_reduce(&around, genus).is_empty() {
+        return Err(SchemaError::Inconsistent(
+            "the words round the last triangle do not multiply to the identity".into(),
+        ));
+    }
+    Ok(out)
 }
