@@ -24,9 +24,9 @@
 
 pub mod cell_complex;
 pub mod halfedge;
+pub mod schema;
 pub mod shape;
 pub mod spatial;
-pub mod schema;
 pub mod validate;
 
 pub use cell_complex::CellComplex;
