@@ -137,6 +137,9 @@ pub fn boundary_loops(mesh: &HalfEdgeMesh) -> Vec<Vec<u32>> {
     loops
 }
 
+/// A face across an edge: the face, whether it must be reversed relative to this one, the edge.
+type Neighbour = (u32, bool, (u32, u32));
+
 /// For each face, whether to reverse it so that every edge with two faces is run along in opposite
 /// directions by them (one orientation per component; the first face of each keeps its own). Edges
 /// with one face or more than two play no part. A mesh that cannot be so oriented (a Möbius strip,
@@ -144,8 +147,7 @@ pub fn boundary_loops(mesh: &HalfEdgeMesh) -> Vec<Vec<u32>> {
 /// the conflict.
 pub fn orient(mesh: &HalfEdgeMesh) -> Result<Vec<bool>, (u32, u32)> {
     let faces = mesh.face_count();
-    // (neighbour, whether it must be flipped relative to this face, the shared edge)
-    let mut neighbours: Vec<Vec<(u32, bool, (u32, u32))>> = vec![Vec::new(); faces];
+    let mut neighbours: Vec<Vec<Neighbour>> = vec![Vec::new(); faces];
     for (key, hs) in edge_groups(mesh) {
         if let [a, b] = hs[..] {
             let flip = mesh.origin(a) == mesh.origin(b);

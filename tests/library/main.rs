@@ -10,5 +10,6 @@ mod export_tools;
 mod figures;
 mod fit;
 mod hardening;
+mod import;
 mod render;
 mod tessellation;

@@ -242,11 +242,11 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ImportError> {
                     corners.swap(1, 2);
                 }
                 // Strips and fans repeat corners where they restart; those are not triangles.
-                if corners[0] == corners[1] || corners[1] == corners[2] || corners[0] == corners[2]
-                {
-                    if mode != Mode::Triangles {
-                        continue;
-                    }
+                let repeats = corners[0] == corners[1]
+                    || corners[1] == corners[2]
+                    || corners[0] == corners[2];
+                if repeats && mode != Mode::Triangles {
+                    continue;
                 }
                 raw.push_polygon(&corners.map(|i| (base + i as usize) as u32))?;
             }

@@ -608,21 +608,27 @@ fn triangulate_into(positions: &[Point3], poly: &[u32], out: &mut Vec<[u32; 3]>)
     if convex {
         return fan(out);
     }
+    // Corners within this of an ear's sides count as on them (so an ear never takes a corner lying
+    // on its third side, which would leave a zero-area triangle behind).
+    let size = flat
+        .iter()
+        .fold(0.0f64, |m, q| m.max(q[0].abs()).max(q[1].abs()));
+    let eps = 1e-10 * size * size;
     let mut left: Vec<usize> = (0..n).collect();
     while left.len() > 3 {
         let m = left.len();
         let is_ear = |i: usize| {
             let (a, b, c) = (left[(i + m - 1) % m], left[i], left[(i + 1) % m]);
-            if cross(flat[a], flat[b], flat[c]) <= 0.0 {
+            if cross(flat[a], flat[b], flat[c]) <= eps {
                 return false;
             }
             left.iter().all(|&q| {
                 q == a
                     || q == b
                     || q == c
-                    || !(cross(flat[a], flat[b], flat[q]) >= 0.0
-                        && cross(flat[b], flat[c], flat[q]) >= 0.0
-                        && cross(flat[c], flat[a], flat[q]) >= 0.0)
+                    || !(cross(flat[a], flat[b], flat[q]) >= -eps
+                        && cross(flat[b], flat[c], flat[q]) >= -eps
+                        && cross(flat[c], flat[a], flat[q]) >= -eps)
             })
         };
         // No ear (a self-intersecting polygon): cut the most convex corner anyway.
