@@ -69,7 +69,7 @@ pub struct LoopReport {
 }
 
 /// Candidate base vertices tried: the one whose generator loops are shortest in total is used.
-const BASE_CANDIDATES: usize = 6;
+const BASE_CANDIDATES: usize = 8;
 
 /// Fits a model to a closed, oriented, manifold, connected triangle mesh of genus ≥ 1 (counter-
 /// clockwise seen from outside). Refuses more than [`crate::fit::MAX_FIT_TRIANGLES`] triangles.
@@ -225,7 +225,7 @@ fn best_marking(
 }
 
 /// Sweeps each candidate marking is relaxed for before they are compared.
-const SCREEN_SWEEPS: usize = 300;
+const SCREEN_SWEEPS: usize = 1000;
 
 /// The area-weighted mean of (ln stretch)²: 0 for a map that shrinks the surface evenly.
 fn uneven_stretch(stretch: &[f64], areas: &[f64]) -> f64 {

@@ -3,11 +3,14 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use embedding::SplineSettings;
+use embedding::fit::FitSettings;
 
 mod bench;
 mod edit;
 mod export;
 mod figures;
+mod fit;
 mod info;
 mod new;
 mod render;
@@ -35,6 +38,7 @@ enum Command {
     Info(info::Args),
     Tessellate(tessellate::Args),
     New(new::Args),
+    Fit(fit::Args),
     Edit(edit::Args),
     Export(export::Args),
     Render(render::Args),
@@ -48,6 +52,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Info(args) => info::run(args),
         Command::Tessellate(args) => tessellate::run(args),
         Command::New(args) => new::run(args),
+        Command::Fit(args) => fit::run(args),
         Command::Edit(args) => edit::run(args),
         Command::Export(args) => export::run(args),
         Command::Render(args) => render::run(args),
@@ -83,6 +88,62 @@ fn parse_genus(s: &str) -> Result<u32, String> {
         )),
     }
 }
+
+/// The spline and the fit's weight, as `new` and `fit` take them.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct FitArgs {
+    /// Control points per side of each chart's grid.
+    #[arg(long, default_value_t = SplineSettings::default().grid as u64, value_name = "G",
+          value_parser = clap::value_parser!(u64).range(4..=64))]
+    grid: u64,
+    /// Spline degree.
+    #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
+          value_parser = clap::value_parser!(u64).range(1..=7))]
+    degree: u64,
+    /// Continuity order of the blend functions (1 to 4).
+    #[arg(long, default_value_t = SplineSettings::default().continuity as u64, value_name = "K",
+          value_parser = clap::value_parser!(u64).range(1..=4))]
+    continuity: u64,
+    /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term).
+    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ",
+          value_parser = parse_smoothness)]
+    smoothness: f64,
+}
+
+impl FitArgs {
+    fn settings(&self) -> (SplineSettings, FitSettings) {
+        let spline = SplineSettings {
+            degree: self.degree as usize,
+            continuity: self.continuity as usize,
+            grid: self.grid as usize,
+        };
+        let fit = FitSettings {
+            smoothness: self.smoothness,
+            ..FitSettings::default()
+        };
+        (spline, fit)
+    }
+}
+
+/// The largest smoothness weight accepted: beyond it the least-squares system is the smoothness
+/// term alone to f64 precision (λ = 1e308 overflowed into non-finite control points).
+const MAX_SMOOTHNESS: f64 = 1e6;
+
+/// λ: a number in (0, 1e6].
+fn parse_smoothness(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v > 0.0 && v <= MAX_SMOOTHNESS {
+        Ok(v)
+    } else {
+        Err(format!(
+            "the smoothness weight must lie in (0, {MAX_SMOOTHNESS:e}], got {v}"
+        ))
+    }
+}
+
 
 /// Writes to stdout; a closed pipe (`ntori info | head`) is not an error.
 fn write_stdout(text: &str) -> anyhow::Result<()> {

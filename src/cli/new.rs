@@ -13,7 +13,7 @@ use ntori::io::export::{self, ExportOptions, Format};
 use serde::Serialize;
 
 use super::report::{Report, emit};
-use super::{GenusArg, spinner};
+use super::{FitArgs, GenusArg, spinner};
 
 /// Make a new model: a smooth genus-n surface fitted to an n-holed mesh, written as a model file.
 ///
@@ -60,22 +60,8 @@ pub struct Args {
     #[arg(long, default_value_t = 32, value_name = "R",
           value_parser = clap::value_parser!(u64).range(8..=1024))]
     resolution: u64,
-    /// Control points per side of each chart's grid.
-    #[arg(long, default_value_t = SplineSettings::default().grid as u64, value_name = "G",
-          value_parser = clap::value_parser!(u64).range(4..=64))]
-    grid: u64,
-    /// Spline degree.
-    #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
-          value_parser = clap::value_parser!(u64).range(1..=7))]
-    degree: u64,
-    /// Continuity order of the blend functions (1 to 4).
-    #[arg(long, default_value_t = SplineSettings::default().continuity as u64, value_name = "K",
-          value_parser = clap::value_parser!(u64).range(1..=4))]
-    continuity: u64,
-    /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term).
-    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ",
-          value_parser = parse_smoothness)]
-    smoothness: f64,
+    #[command(flatten)]
+    spline: FitArgs,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -92,13 +78,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         keep_failed,
         input_mesh,
         resolution,
-        grid,
-        degree,
-        continuity,
-        smoothness,
+        spline,
         json,
         quiet,
     } = args;
+    let (settings, fit) = spline.settings();
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;
@@ -115,15 +99,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             Some((path, format))
         }
         None => None,
-    };
-    let settings = SplineSettings {
-        degree: degree as usize,
-        continuity: continuity as usize,
-        grid: grid as usize,
-    };
-    let fit = FitSettings {
-        smoothness,
-        ..FitSettings::default()
     };
     let bar = spinner(quiet);
     let made = make(genus, resolution as usize, settings, fit, &|stage| {
@@ -171,25 +146,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
 /// The report once the model is saved: as text it also says where the model went; as JSON it is
 /// the report alone.
-/// The largest smoothness weight accepted: beyond it the least-squares system is the smoothness
-/// term alone to f64 precision (λ = 1e308 overflowed into non-finite control points).
-const MAX_SMOOTHNESS: f64 = 1e6;
-
-/// λ: a number in (0, 1e6].
-fn parse_smoothness(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("{s:?} is not a number"))?;
-    if v.is_finite() && v > 0.0 && v <= MAX_SMOOTHNESS {
-        Ok(v)
-    } else {
-        Err(format!(
-            "the smoothness weight must lie in (0, {MAX_SMOOTHNESS:e}], got {v}"
-        ))
-    }
-}
-
 #[derive(Serialize)]
 #[serde(transparent)]
 struct Written<'a> {
@@ -266,14 +222,15 @@ const SHAPE_SAMPLES: u32 = 16;
 fn measure_shape(
     surface: &Surface,
     fit: &embedding::fit::Parameterization,
-    mesh: &embedding::holed::HoledMesh,
+    positions: &[embedding::Point3],
+    triangles: &[[u32; 3]],
     diagonal: f64,
 ) -> Result<ShapeReport, embedding::EmbeddingError> {
     use embedding::quality;
     let points = quality::sample_points(surface, SHAPE_SAMPLES)?;
     let disagreement = quality::patch_disagreement(surface, &points, 0.1);
     let curvature = quality::max_principal_curvature(surface, &points);
-    let normals = quality::normal_deviation(surface, &fit.points, &mesh.positions, &mesh.triangles);
+    let normals = quality::normal_deviation(surface, &fit.points, positions, triangles);
     Ok(ShapeReport {
         patch_disagreement: disagreement.max / diagonal,
         patch_disagreement_rms: disagreement.rms / diagonal,
@@ -287,6 +244,70 @@ fn measure_shape(
 pub const CURVATURE_TOLERANCE: f64 = 1e-3;
 /// Largest residual, as a fraction of the diagonal, the check accepts.
 pub const RESIDUAL_TOLERANCE: f64 = 0.01;
+
+/// A fitted model and what it was fitted to, for [`check`].
+pub struct Fitted<'a> {
+    pub surface: &'a Surface,
+    pub genus: u32,
+    pub parameterization: &'a embedding::fit::Parameterization,
+    pub positions: &'a [embedding::Point3],
+    pub triangles: &'a [[u32; 3]],
+    pub rms_residual: f64,
+    pub max_residual: f64,
+    pub mesh_diagonal: f64,
+    pub settings: SplineSettings,
+    pub smoothness: f64,
+}
+
+/// The checks and measures of a fit (`ntori new` and `ntori fit` alike): folds, residual,
+/// Gauss–Bonnet and the shape measures. `start` is when the work began.
+pub fn check(
+    fitted: &Fitted,
+    start: std::time::Instant,
+    stage: &dyn Fn(&str),
+) -> Result<NewReport, embedding::EmbeddingError> {
+    let Fitted {
+        surface,
+        genus,
+        parameterization,
+        positions,
+        triangles,
+        rms_residual,
+        max_residual,
+        mesh_diagonal,
+        settings,
+        smoothness,
+    } = *fitted;
+    stage("integrating the curvature");
+    let sums = surface_integrals(&surface.layout(), surface.control_points(), 8);
+    let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
+    let curvature_error =
+        (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
+    stage("measuring the shape");
+    let shape = measure_shape(surface, parameterization, positions, triangles, mesh_diagonal)?;
+    Ok(NewReport {
+        genus,
+        settings,
+        smoothness,
+        mesh_vertices: positions.len(),
+        mesh_triangles: triangles.len(),
+        control_points: surface.control_points().len(),
+        sweeps: parameterization.sweeps,
+        folded_triangles: parameterization.folded,
+        rms_residual: rms_residual / mesh_diagonal,
+        max_residual: max_residual / mesh_diagonal,
+        diagonal: mesh_diagonal,
+        total_curvature: sums.gaussian_curvature,
+        expected_curvature: expected,
+        curvature_error,
+        area: sums.area,
+        shape,
+        seconds: start.elapsed().as_secs_f64(),
+        passed: parameterization.folded == 0
+            && curvature_error <= CURVATURE_TOLERANCE
+            && max_residual <= RESIDUAL_TOLERANCE * mesh_diagonal,
+    })
+}
 
 /// What [`make`] produced: the model, its report, and the mesh it was fitted to with the chart
 /// point each mesh vertex was fitted at.
@@ -314,35 +335,19 @@ pub fn make(
         max_residual,
         mesh_diagonal,
     } = initial_model_with_progress(genus, resolution, settings, fit, &|s| stage(&s.to_string()))?;
-    stage("integrating the curvature");
-    let sums = surface_integrals(&surface.layout(), surface.control_points(), 8);
-    let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
-    let curvature_error =
-        (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
-    stage("measuring the shape");
-    let shape = measure_shape(&surface, &parameterization, &mesh, mesh_diagonal)?;
-    let report = NewReport {
+    let checked = Fitted {
+        surface: &surface,
         genus,
+        parameterization: &parameterization,
+        positions: &mesh.positions,
+        triangles: &mesh.triangles,
+        rms_residual,
+        max_residual,
+        mesh_diagonal,
         settings,
         smoothness: fit.smoothness,
-        mesh_vertices: mesh.positions.len(),
-        mesh_triangles: mesh.triangles.len(),
-        control_points: surface.control_points().len(),
-        sweeps: parameterization.sweeps,
-        folded_triangles: parameterization.folded,
-        rms_residual: rms_residual / mesh_diagonal,
-        max_residual: max_residual / mesh_diagonal,
-        diagonal: mesh_diagonal,
-        total_curvature: sums.gaussian_curvature,
-        expected_curvature: expected,
-        curvature_error,
-        area: sums.area,
-        shape,
-        seconds: start.elapsed().as_secs_f64(),
-        passed: parameterization.folded == 0
-            && curvature_error <= CURVATURE_TOLERANCE
-            && max_residual <= RESIDUAL_TOLERANCE * mesh_diagonal,
     };
+    let report = check(&checked, start, stage)?;
     Ok(Made {
         surface,
         report,
@@ -353,7 +358,7 @@ pub fn make(
 
 impl NewReport {
     /// The human-readable form (without the line saying where the model went).
-    fn to_text(&self) -> String {
+    pub fn to_text(&self) -> String {
         let verdict = |ok: bool| if ok { "ok" } else { "FAILED" };
         format!(
             "genus {genus}: degree {degree}, C^{cont} blends, {grid}×{grid} control grid per chart, \

@@ -1,0 +1,178 @@
+//! Fitting a mesh that comes without loops: the loop system, its canonical form, the holonomy and
+//! the map, on plates whose vertices are shuffled (so the trees, the base vertex and the relation
+//! differ from case to case).
+
+use charts::{Lft, Polygon};
+use embedding::SplineSettings;
+use embedding::fit::FitSettings;
+use embedding::holed::HoledMesh;
+use embedding::mesh_fit::{canonical_element, mesh_model, word_element};
+use mesh::HalfEdgeMesh;
+use mesh::schema::{
+    Letter, canonicalize, cyclically_equal, dehn_reduce, edge_words, inverse, loop_system,
+    substitute,
+};
+use proptest::prelude::*;
+
+/// The plate of `genus` with its vertices renumbered by `seed`'s permutation.
+fn shuffled_plate(
+    genus: u32,
+    resolution: usize,
+    seed: u64,
+) -> (Vec<embedding::Point3>, Vec<[u32; 3]>) {
+    let mesh = HoledMesh::new(genus, resolution).unwrap();
+    let n = mesh.positions.len();
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    for i in (1..n).rev() {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        order.swap(i, (state >> 33) as usize % (i + 1));
+    }
+    let mut positions = vec![mesh.positions[0]; n];
+    for (old, &new) in order.iter().enumerate() {
+        positions[new as usize] = mesh.positions[old];
+    }
+    let triangles = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| order[v as usize]))
+        .collect();
+    (positions, triangles)
+}
+
+fn canonical_word(genus: u32) -> Vec<Letter> {
+    (0..genus)
+        .flat_map(|k| {
+            let (a, b) = (
+                Letter::from_signed(2 * k as i32 + 1),
+                Letter::from_signed(2 * k as i32 + 2),
+            );
+            [a, b, a.inv(), b.inv()]
+        })
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The greedy loops' relation uses each of 2g generators once each way; its canonical form
+    /// substituted back reads a₁ b₁ a₁⁻¹ b₁⁻¹ …; the edge words close round every triangle; the loops
+    /// are closed paths through the base vertex.
+    #[test]
+    fn loops_become_canonical(genus in 1u32..=6, seed in any::<u64>(), base in any::<prop::sample::Index>()) {
+        let (positions, triangles) = shuffled_plate(genus, 8, seed);
+        let he = HalfEdgeMesh::from_polygons(positions.len(), triangles.iter().map(|t| &t[..])).unwrap();
+        let length = |h: u32| (positions[he.target(h) as usize] - positions[he.origin(h) as usize]).norm();
+        let base = base.index(positions.len()) as u32;
+        let system = loop_system(&he, length, base).unwrap();
+        prop_assert_eq!(system.generators.len(), 2 * genus as usize);
+        prop_assert_eq!(system.relation.len(), 4 * genus as usize);
+        let canonical = canonicalize(&system.relation, system.generators.len()).unwrap();
+        let back = substitute(&system.relation, &canonical.originals);
+        prop_assert!(cyclically_equal(&back, &canonical_word(genus)));
+        let words: Vec<_> = canonical.originals.iter().map(|w| dehn_reduce(w, genus as usize)).collect();
+        let per_edge = edge_words(&he, &system, &words, genus as usize).unwrap();
+        let polygon = Polygon::new(genus).unwrap();
+        for f in 0..he.face_count() as u32 {
+            let around: Vec<Letter> = he.face_halfedges(f).flat_map(|h| per_edge[h as usize].clone()).collect();
+            prop_assert!(dehn_reduce(&around, genus as usize).is_empty());
+            let elements: Vec<Lft> = he.face_halfedges(f).map(|h| word_element(&polygon, &per_edge[h as usize])).collect();
+            let scale = elements.iter().flat_map(|g| g.matrix()).map(|z| z.norm()).fold(1.0, f64::max);
+            let product = elements.iter().fold(Lft::IDENTITY, |acc, g| acc.compose(g));
+            prop_assert!(product.distance(&Lft::IDENTITY) < 1e-12 * scale.powi(3));
+        }
+        for i in 0..system.generators.len() {
+            let path = system.loop_path(&he, i);
+            prop_assert_eq!(path[0], base);
+            prop_assert_eq!(*path.last().unwrap(), base);
+        }
+    }
+
+    /// Dehn's algorithm keeps the group element and removes conjugated relators entirely.
+    #[test]
+    fn dehn_reduction_keeps_the_element(genus in 2u32..=5, letters in prop::collection::vec(-10i32..=10, 0..24), rotation in 0usize..20) {
+        let w: Vec<Letter> = letters
+            .iter()
+            .filter(|&&s| s != 0)
+            .map(|&s| Letter { generator: (s.unsigned_abs() - 1) % (2 * genus), inverse: s < 0 })
+            .collect();
+        let polygon = Polygon::new(genus).unwrap();
+        let reduced = dehn_reduce(&w, genus as usize);
+        prop_assert!(reduced.len() <= w.len());
+        let (full, short) = (word_element(&polygon, &w), word_element(&polygon, &reduced));
+        let scale = 1.0 + full.matrix().iter().map(|z| z.norm()).fold(0.0, f64::max);
+        prop_assert!(full.distance(&short) < 1e-6 * scale);
+        let mut relator = canonical_word(genus);
+        let len = relator.len();
+        relator.rotate_left(rotation % len);
+        let conjugated = [w.clone(), relator, inverse(&w)].concat();
+        prop_assert!(dehn_reduce(&conjugated, genus as usize).is_empty());
+    }
+}
+
+/// The canonical letters' elements satisfy ∏[a_k, b_k] = 1 at every genus (composed left to right).
+#[test]
+fn canonical_elements_satisfy_the_relation() {
+    for genus in 1..=12 {
+        let polygon = Polygon::new(genus).unwrap();
+        let relation = word_element(&polygon, &canonical_word(genus));
+        assert!(
+            relation.distance(&Lft::IDENTITY) < 1e-7,
+            "genus {genus}: {relation:?}"
+        );
+        // Not trivially: a_k and b_k do not commute for genus ≥ 2.
+        if genus >= 2 {
+            let (a, b) = (
+                canonical_element(&polygon, Letter::from_signed(1)),
+                canonical_element(&polygon, Letter::from_signed(2)),
+            );
+            assert!(a.compose(&b).distance(&b.compose(&a)) > 1e-3);
+        }
+    }
+}
+
+/// Shuffled plates of genus 1 to 4 fit as the plates themselves do: a bijection, the residual
+/// within the checks' 1%, every vertex in a chart.
+#[test]
+fn shuffled_plates_fit() {
+    for (genus, seed) in [(1, 7), (2, 11), (3, 13), (4, 17)] {
+        let (positions, triangles) = shuffled_plate(genus, 12, seed);
+        let fit = mesh_model(
+            &positions,
+            &triangles,
+            SplineSettings::default(),
+            FitSettings::default(),
+            &|_| {},
+        )
+        .unwrap();
+        assert_eq!(fit.genus, genus);
+        assert_eq!(fit.parameterization.folded, 0, "genus {genus}");
+        assert!(
+            fit.max_residual < 0.01 * fit.mesh_diagonal,
+            "genus {genus}: max residual {} of {}",
+            fit.max_residual,
+            fit.mesh_diagonal
+        );
+        assert_eq!(fit.parameterization.points.len(), positions.len());
+        assert!(fit.loops.closure_error < 1e-8);
+    }
+}
+
+/// A sphere is refused with a message, not fitted wrongly.
+#[test]
+fn genus_zero_is_refused() {
+    let mesh = HoledMesh::new(0, 8).unwrap();
+    let err = mesh_model(
+        &mesh.positions,
+        &mesh.triangles,
+        SplineSettings::default(),
+        FitSettings::default(),
+        &|_| {},
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("genus 0"), "{err}");
+}

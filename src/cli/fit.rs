@@ -1,0 +1,238 @@
+//! `ntori fit`: a user's closed mesh becomes a smooth model.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use embedding::fit::{FitStage, MAX_FIT_TRIANGLES};
+use embedding::mesh_fit::{MeshFit, mesh_model};
+use ntori::io::import::{self, ValidMesh};
+use serde::Serialize;
+
+use super::new::{Fitted, NewReport, check};
+use super::report::{Report, emit};
+use super::{FitArgs, spinner};
+
+/// Fit a smooth model to a closed mesh: OBJ, PLY, OFF, STL or GLB, of genus 1 to 64.
+///
+/// The mesh is read (polygons triangulated, coincident vertices merged where the format stores
+/// none) and checked: one closed, consistently oriented manifold without degenerate triangles, or
+/// an error that says what is wrong and where. Its genus comes from its Euler characteristic.
+///
+/// A system of 2g loops through one vertex is grown (a shortest-path tree and its dual), the
+/// relation the loops satisfy is brought to the canonical form a₁ b₁ a₁⁻¹ b₁⁻¹ …, and every edge
+/// gets the side pairing of the polygon it crosses. The mesh is then mapped onto the surface by the
+/// same relaxation and fit as `ntori new`, with the same checks: folded triangles (0: a bijection),
+/// the residual at the mesh vertices, Gauss–Bonnet, and the shape measures. If a check fails, no
+/// model is written (unless --keep-failed) and the exit status is 3.
+///
+/// Genus 0 (a sphere-like mesh) is not fitted yet.
+///
+/// Examples:
+///   ntori fit assets/meshes/pretzel.obj -o pretzel.json
+///   ntori fit scan.stl --largest --grid 16
+#[derive(clap::Args, Debug)]
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    /// The mesh to fit (the format from the extension).
+    #[arg(value_name = "MESH")]
+    mesh: PathBuf,
+    /// Where to write the model.
+    #[arg(short, long, default_value = "model.json", value_name = "FILE")]
+    output: PathBuf,
+    /// Replace the output file if it exists.
+    #[arg(long)]
+    force: bool,
+    /// Write the model even if a check fails (the exit status is still 3).
+    #[arg(long)]
+    keep_failed: bool,
+    /// If the mesh has several separate pieces, fit the largest (by triangles).
+    #[arg(long)]
+    largest: bool,
+    #[command(flatten)]
+    spline: FitArgs,
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+    /// No progress messages on stderr.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let start = std::time::Instant::now();
+    let target = ntori::io::atomic::check_output(&args.output, &[&args.mesh])?;
+    if !args.force && std::fs::symlink_metadata(&target).is_ok() {
+        return Err(ntori::io::atomic::FileError::Exists { path: args.output }.into());
+    }
+    let read = import::read_mesh(&args.mesh)?;
+    let (merged, triangulated) = (read.merged_vertices, read.triangulated_polygons);
+    let valid = import::validate(read, args.largest)
+        .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
+    refuse_unfittable(&args.mesh, &valid)?;
+    let (settings, fit) = args.spline.settings();
+    let bar = spinner(args.quiet);
+    let progress = |stage: &str| {
+        bar.set_message(stage.to_string());
+        bar.tick();
+    };
+    let fitted = mesh_model(
+        &valid.positions,
+        &valid.triangles,
+        settings,
+        fit,
+        &|s: FitStage| progress(&s.to_string()),
+    )
+    .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
+    let report = check(&as_fitted(&fitted, &valid, settings, fit.smoothness), start, &progress)?;
+    bar.finish_and_clear();
+    let written = report.passed || args.keep_failed;
+    if written && args.force {
+        ntori::io::model_file::save(&args.output, &fitted.surface)?;
+    } else if written {
+        ntori::io::model_file::save_new(&args.output, &fitted.surface)?;
+    }
+    let report = FitReport {
+        input: InputReport {
+            path: args.mesh.display().to_string(),
+            merged_vertices: merged,
+            triangulated_polygons: triangulated,
+            dropped_components: valid.dropped_components,
+            reoriented_triangles: valid.reoriented_triangles,
+            flipped: valid.flipped,
+        },
+        loops: LoopsReport::of(&fitted),
+        fit: report,
+        output: &args.output,
+        written,
+    };
+    emit(&report, args.json)
+}
+
+/// Genus 0 and meshes beyond the fit's size are refused before any work.
+fn refuse_unfittable(path: &Path, valid: &ValidMesh) -> anyhow::Result<()> {
+    if valid.genus == 0 {
+        anyhow::bail!(
+            "cannot fit {}: it has genus 0 (a sphere), which `ntori fit` does not fit yet; `ntori new --genus 0` makes a sphere",
+            path.display()
+        );
+    }
+    if valid.triangles.len() > MAX_FIT_TRIANGLES {
+        anyhow::bail!(
+            "cannot fit {}: it has {} triangles, and the fit takes at most {MAX_FIT_TRIANGLES} (decimate it first)",
+            path.display(),
+            valid.triangles.len()
+        );
+    }
+    Ok(())
+}
+
+fn as_fitted<'a>(
+    fit: &'a MeshFit,
+    valid: &'a ValidMesh,
+    settings: embedding::SplineSettings,
+    smoothness: f64,
+) -> Fitted<'a> {
+    Fitted {
+        surface: &fit.surface,
+        genus: fit.genus,
+        parameterization: &fit.parameterization,
+        positions: &valid.positions,
+        triangles: &valid.triangles,
+        rms_residual: fit.rms_residual,
+        max_residual: fit.max_residual,
+        mesh_diagonal: fit.mesh_diagonal,
+        settings,
+        smoothness,
+    }
+}
+
+/// What `ntori fit` read and made.
+#[derive(Serialize)]
+struct FitReport<'a> {
+    input: InputReport,
+    loops: LoopsReport,
+    fit: NewReport,
+    #[serde(skip)]
+    output: &'a Path,
+    #[serde(skip)]
+    written: bool,
+}
+
+/// What reading the mesh changed.
+#[derive(Serialize)]
+struct InputReport {
+    path: String,
+    merged_vertices: usize,
+    triangulated_polygons: usize,
+    dropped_components: usize,
+    reoriented_triangles: usize,
+    flipped: bool,
+}
+
+/// The loop system the map was built on.
+#[derive(Serialize)]
+struct LoopsReport {
+    base_vertex: u32,
+    /// Edges in each generator loop.
+    loop_edges: Vec<usize>,
+    /// Letters in each generator's canonical word (1: the loop is a canonical loop itself).
+    canonical_word_lengths: Vec<usize>,
+}
+
+impl LoopsReport {
+    fn of(fit: &MeshFit) -> LoopsReport {
+        LoopsReport {
+            base_vertex: fit.loops.base,
+            loop_edges: fit.loops.paths.iter().map(|p| p.len() - 1).collect(),
+            canonical_word_lengths: fit.loops.canonical.iter().map(Vec::len).collect(),
+        }
+    }
+}
+
+impl Report for FitReport<'_> {
+    fn passed(&self) -> bool {
+        self.fit.passed
+    }
+
+    fn to_text(&self) -> String {
+        let i = &self.input;
+        let mut notes = Vec::new();
+        if i.merged_vertices > 0 {
+            notes.push(format!("{} coincident vertices merged", i.merged_vertices));
+        }
+        if i.triangulated_polygons > 0 {
+            notes.push(format!("{} polygons triangulated", i.triangulated_polygons));
+        }
+        if i.dropped_components > 0 {
+            notes.push(format!("{} smaller pieces left out", i.dropped_components));
+        }
+        if i.reoriented_triangles > 0 {
+            notes.push(format!("{} triangles turned to agree", i.reoriented_triangles));
+        }
+        if i.flipped {
+            notes.push("turned right side out".to_string());
+        }
+        let notes = if notes.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", notes.join(", "))
+        };
+        let longest = self.loops.canonical_word_lengths.iter().max().unwrap_or(&0);
+        let outcome = if self.written {
+            format!("wrote {}\n", self.output.display())
+        } else {
+            format!(
+                "not written to {}: a check failed (--keep-failed writes it anyway)\n",
+                self.output.display()
+            )
+        };
+        format!(
+            "read {}{notes}\nloops: {} through vertex {}, canonical words of up to {longest} letters\n",
+            i.path,
+            self.loops.loop_edges.len(),
+            self.loops.base_vertex,
+        ) + &self.fit.to_text()
+            + &outcome
+    }
+}
