@@ -7,6 +7,7 @@ mod common;
 mod bench;
 mod export;
 mod figures;
+mod fit;
 mod hardening;
 mod info;
 mod new;

@@ -1,0 +1,69 @@
+//! `ntori fit`: a user's mesh becomes a model with new's checks; bad meshes get located errors and
+//! nothing is written.
+
+use predicates::prelude::*;
+
+use crate::common::{asset, ntori};
+
+#[test]
+fn fit_writes_a_model_of_the_mesh_genus_that_passes_its_checks() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("plate.json");
+    let out = ntori()
+        .arg("fit")
+        .arg(asset("meshes/plate-genus-3.obj"))
+        .args(["--json", "-q", "-o"])
+        .arg(&path)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(report["fit"]["passed"], true);
+    assert_eq!(report["fit"]["genus"], 3);
+    assert_eq!(report["fit"]["folded_triangles"], 0);
+    assert_eq!(report["loops"]["loop_edges"].as_array().unwrap().len(), 6);
+    assert!(report["fit"]["max_residual"].as_f64().unwrap() < 0.01);
+    let model: embedding::Model =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let atlas = charts::Atlas::new(3).unwrap();
+    let layout = embedding::Layout::new(&atlas, model.settings).unwrap();
+    model.validate(&layout).unwrap();
+}
+
+#[test]
+fn fit_refuses_open_and_spherical_meshes_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.json");
+    // An open square (two triangles) and a closed tetrahedron (genus 0).
+    let open = dir.path().join("open.obj");
+    std::fs::write(
+        &open,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let tetra = dir.path().join("tetra.off");
+    std::fs::write(
+        &tetra,
+        "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n",
+    )
+    .unwrap();
+    for (mesh, message) in [
+        (&open, "the mesh is not closed: it has 1 hole"),
+        (&tetra, "it has genus 0"),
+    ] {
+        ntori()
+            .arg("fit")
+            .arg(mesh)
+            .arg("-o")
+            .arg(&out)
+            .assert()
+            .failure()
+            .stderr(predicate::str::contains(message))
+            .stderr(predicate::str::contains(
+                mesh.file_name().unwrap().to_str().unwrap(),
+            ));
+        assert!(!out.exists());
+    }
+}
