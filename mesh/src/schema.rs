@@ -428,7 +428,7 @@ pub fn canonicalize(relation: &[Letter], generators: usize) -> Result<Canonical,
             None => return Err(bad("a letter is not a generator")),
         }
     }
-    if generators % 2 != 0 || uses.iter().any(|u| *u != [1, 1]) {
+    if !generators.is_multiple_of(2) || uses.iter().any(|u| *u != [1, 1]) {
         return Err(bad(
             "the relation does not use every generator once each way",
         ));
