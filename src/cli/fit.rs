@@ -84,7 +84,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         &|s: FitStage| progress(&s.to_string()),
     )
     .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
-    let report = check(&as_fitted(&fitted, &valid, settings, fit.smoothness), start, &progress)?;
+    let report = check(
+        &as_fitted(&fitted, &valid, settings, fit.smoothness),
+        start,
+        &progress,
+    )?;
     bar.finish_and_clear();
     let written = report.passed || args.keep_failed;
     if written && args.force {
@@ -208,7 +212,10 @@ impl Report for FitReport<'_> {
             notes.push(format!("{} smaller pieces left out", i.dropped_components));
         }
         if i.reoriented_triangles > 0 {
-            notes.push(format!("{} triangles turned to agree", i.reoriented_triangles));
+            notes.push(format!(
+                "{} triangles turned to agree",
+                i.reoriented_triangles
+            ));
         }
         if i.flipped {
             notes.push("turned right side out".to_string());

@@ -144,7 +144,6 @@ fn parse_smoothness(s: &str) -> Result<f64, String> {
     }
 }
 
-
 /// Writes to stdout; a closed pipe (`ntori info | head`) is not an error.
 fn write_stdout(text: &str) -> anyhow::Result<()> {
     use std::io::Write as _;

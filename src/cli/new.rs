@@ -284,7 +284,13 @@ pub fn check(
     let curvature_error =
         (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
     stage("measuring the shape");
-    let shape = measure_shape(surface, parameterization, positions, triangles, mesh_diagonal)?;
+    let shape = measure_shape(
+        surface,
+        parameterization,
+        positions,
+        triangles,
+        mesh_diagonal,
+    )?;
     Ok(NewReport {
         genus,
         settings,
