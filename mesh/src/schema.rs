@@ -29,6 +29,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use crate::HalfEdgeMesh;
+use crate::halfedge::UnionFind;
 
 /// A generator or its inverse.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -157,7 +158,7 @@ pub fn loop_system(
         })
         .collect();
     candidates.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    let mut faces = DisjointSets::new(mesh.face_count());
+    let mut faces = UnionFind::new(mesh.face_count());
     let mut generators = Vec::new();
     for (_, h) in candidates {
         let t = twin(h)?;
@@ -323,30 +324,6 @@ impl PartialOrd for Ordered {
 impl Ord for Ordered {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
         self.0.total_cmp(&other.0)
-    }
-}
-
-struct DisjointSets(Vec<u32>);
-impl DisjointSets {
-    fn new(n: usize) -> Self {
-        DisjointSets((0..n as u32).collect())
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let up = self.0[self.0[x as usize] as usize];
-            self.0[x as usize] = up;
-            x = up;
-        }
-        x
-    }
-    /// Joins the sets of a and b; false if they were one already.
-    fn union(&mut self, a: u32, b: u32) -> bool {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra == rb {
-            return false;
-        }
-        self.0[ra as usize] = rb;
-        true
     }
 }
 

@@ -23,6 +23,7 @@
 use std::collections::HashMap;
 
 use crate::HalfEdgeMesh;
+use crate::halfedge::UnionFind;
 
 /// Half-edges grouped by undirected edge (smaller endpoint first), groups in order of their first
 /// half-edge.
@@ -77,27 +78,17 @@ fn one_fan(mesh: &HalfEdgeMesh, corners: &[u32]) -> bool {
         by_edge.entry(key(h)).or_default().push(i as u32);
         by_edge.entry(key(mesh.prev(h))).or_default().push(i as u32);
     }
-    let mut parent: Vec<u32> = (0..corners.len() as u32).collect();
+    let mut sets = UnionFind::new(corners.len());
     for at in by_edge.values() {
         if at.len() > 2 {
             return false;
         }
         if let [a, b] = at[..] {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            parent[ra as usize] = rb;
+            sets.union(a, b);
         }
     }
-    let root = find(&mut parent, 0);
-    (0..corners.len() as u32).all(|i| find(&mut parent, i) == root)
-}
-
-fn find(parent: &mut [u32], mut x: u32) -> u32 {
-    while parent[x as usize] != x {
-        let p = parent[x as usize];
-        parent[x as usize] = parent[p as usize];
-        x = p;
-    }
-    x
+    let root = sets.find(0);
+    (0..corners.len() as u32).all(|i| sets.find(i) == root)
 }
 
 /// The boundary loops, each as its vertices in order (a loop of n vertices has n edges). On a
@@ -194,13 +185,12 @@ pub fn face_components<'a>(
     vertex_count: usize,
     polygons: impl IntoIterator<Item = &'a [u32]> + Clone,
 ) -> (Vec<u32>, usize) {
-    let mut parent: Vec<u32> = (0..vertex_count as u32).collect();
+    let mut sets = UnionFind::new(vertex_count);
     for poly in polygons.clone() {
         let mut inside = poly.iter().filter(|&&v| (v as usize) < vertex_count);
         if let Some(&first) = inside.next() {
             for &v in inside {
-                let (ra, rb) = (find(&mut parent, first), find(&mut parent, v));
-                parent[ra as usize] = rb;
+                sets.union(first, v);
             }
         }
     }
@@ -210,7 +200,7 @@ pub fn face_components<'a>(
         let root = poly
             .iter()
             .find(|&&v| (v as usize) < vertex_count)
-            .map_or(u32::MAX, |&v| find(&mut parent, v));
+            .map_or(u32::MAX, |&v| sets.find(v));
         let next = number.len() as u32;
         component.push(*number.entry(root).or_insert(next));
     }
