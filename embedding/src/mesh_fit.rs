@@ -103,6 +103,7 @@ pub fn mesh_model(
     let polygon = atlas.polygon().expect("genus ≥ 1 has a polygon");
     let hyperbolic = genus >= 2;
 
+    let areas = vertex_areas(positions, triangles);
     let length =
         |h: u32| (positions[he.target(h) as usize] - positions[he.origin(h) as usize]).norm();
     let Marked {
@@ -110,7 +111,7 @@ pub fn mesh_model(
         words,
         closure_error,
         mut lifts,
-    } = best_marking(&he, positions, triangles, polygon, &length)?;
+    } = best_marking(&he, positions, triangles, &areas, polygon, &length)?;
     let rounds = fit_settings.stretch_rounds + 1;
     let mut sweeps = 0;
     for round in 1..=rounds {
@@ -129,8 +130,7 @@ pub fn mesh_model(
         .collect::<Result<Vec<_>, _>>()?;
 
     progress(FitStage::Fitting);
-    let weights = vertex_areas(positions, triangles);
-    let control = fit(&layout, &points, positions, &weights, fit_settings)?;
+    let control = fit(&layout, &points, positions, &areas, fit_settings)?;
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (p, target) in points.iter().zip(positions) {
         let e = (layout.eval(&control, *p).pos - target).norm();
@@ -182,13 +182,13 @@ fn best_marking(
     he: &HalfEdgeMesh,
     positions: &[Point3],
     triangles: &[[u32; 3]],
+    areas: &[f64],
     polygon: &Polygon,
     length: &impl Fn(u32) -> f64,
 ) -> Result<Marked, EmbeddingError> {
     let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
     let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
     let genus = polygon.genus() as usize;
-    let areas = vertex_areas(positions, triangles);
     let mut best: Option<(f64, Marked)> = None;
     let mut nearest = vec![f64::INFINITY; he.vertex_count()];
     let mut base = 0u32;
@@ -210,7 +210,7 @@ fn best_marking(
         let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
         let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
         lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
-        let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), &areas);
+        let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
         if best.as_ref().is_none_or(|(s, _)| score < *s) {
             let marked = Marked {
                 system,
