@@ -837,6 +837,40 @@ pub(crate) fn parse_f64(token: &str) -> Option<f64> {
     token.parse::<f64>().ok()
 }
 
+/// A vertex's three coordinates from the tokens of text line `line` (OBJ, OFF, ASCII STL). `who`
+/// names it in messages ("a vertex", "vertex 3"); `vertex` is its index, for the non-finite error.
+pub(crate) fn text_vertex<'a>(
+    tokens: &mut impl Iterator<Item = &'a str>,
+    format: MeshFormat,
+    line: usize,
+    who: &str,
+    vertex: usize,
+) -> Result<Point3, ImportError> {
+    let error = |message: String| ImportError::Parse {
+        format,
+        at: Location::Line(line),
+        message,
+    };
+    let mut xyz = [0.0; 3];
+    for (k, slot) in xyz.iter_mut().enumerate() {
+        let token = tokens
+            .next()
+            .ok_or_else(|| error(format!("{who} needs three coordinates, found {k}")))?;
+        *slot = parse_f64(token)
+            .ok_or_else(|| error(format!("`{}` is not a number", obj::quote(token))))?;
+    }
+    if !xyz.iter().all(|x| x.is_finite()) {
+        return Err(ImportError::NonFinite {
+            vertex,
+            at: Location::Line(line),
+            x: xyz[0],
+            y: xyz[1],
+            z: xyz[2],
+        });
+    }
+    Ok(Point3::from(xyz))
+}
+
 /// Lines of a text file, numbered from 1, with `\r` removed and invalid UTF-8 replaced.
 pub(crate) fn text_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, std::borrow::Cow<'_, str>)> {
     bytes.split(|&b| b == b'\n').enumerate().map(|(i, line)| {

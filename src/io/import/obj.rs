@@ -4,9 +4,7 @@
 //! (`vt`, `vn`, `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, `p`, …) is ignored. Coordinates are read
 //! as f64 (tobj reads f32 and says no line), and errors give the line.
 
-use embedding::Point3;
-
-use super::{ImportError, Location, MeshFormat, RawMesh, parse_f64, text_lines};
+use super::{ImportError, Location, MeshFormat, RawMesh, text_lines, text_vertex};
 
 const FORMAT: MeshFormat = MeshFormat::Obj;
 
@@ -43,31 +41,11 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ImportError> {
         let mut tokens = content.split_whitespace();
         match tokens.next() {
             Some("v") => {
-                let mut xyz = [0.0; 3];
-                for (k, slot) in xyz.iter_mut().enumerate() {
-                    let token = tokens.next().ok_or_else(|| {
-                        parse_error(
-                            number,
-                            format!("a vertex needs three coordinates, found {k}"),
-                        )
-                    })?;
-                    *slot = parse_f64(token).ok_or_else(|| {
-                        parse_error(number, format!("`{}` is not a number", quote(token)))
-                    })?;
-                }
-                if !xyz.iter().all(|x| x.is_finite()) {
-                    return Err(ImportError::NonFinite {
-                        vertex: raw.positions.len(),
-                        at: Location::Line(number),
-                        x: xyz[0],
-                        y: xyz[1],
-                        z: xyz[2],
-                    });
-                }
+                let p = text_vertex(&mut tokens, FORMAT, number, "a vertex", raw.positions.len())?;
                 if raw.positions.len() >= u32::MAX as usize {
                     return Err(parse_error(number, "too many vertices".into()));
                 }
-                raw.positions.push(Point3::from(xyz));
+                raw.positions.push(p);
             }
             Some("f") | Some("fo") => {
                 corners.clear();

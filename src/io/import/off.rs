@@ -5,10 +5,8 @@
 //! lines are skipped. Four-dimensional (`4OFF`), `nOFF` and binary OFF are refused as unsupported.
 //! Errors give the line.
 
-use embedding::Point3;
-
 use super::obj::quote;
-use super::{ImportError, Location, MeshFormat, RawMesh, parse_f64, text_lines};
+use super::{ImportError, Location, MeshFormat, RawMesh, text_lines, text_vertex};
 
 const FORMAT: MeshFormat = MeshFormat::Off;
 
@@ -110,25 +108,9 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ImportError> {
             ));
         };
         last_line = n;
-        let mut xyz = [0.0; 3];
         let mut tokens = l.split_whitespace();
-        for (k, slot) in xyz.iter_mut().enumerate() {
-            let token = tokens.next().ok_or_else(|| {
-                parse_error(n, format!("vertex {v} needs three coordinates, found {k}"))
-            })?;
-            *slot = parse_f64(token)
-                .ok_or_else(|| parse_error(n, format!("`{}` is not a number", quote(token))))?;
-        }
-        if !xyz.iter().all(|x| x.is_finite()) {
-            return Err(ImportError::NonFinite {
-                vertex: v,
-                at: Location::Line(n),
-                x: xyz[0],
-                y: xyz[1],
-                z: xyz[2],
-            });
-        }
-        raw.positions.push(Point3::from(xyz));
+        let p = text_vertex(&mut tokens, FORMAT, n, &format!("vertex {v}"), v)?;
+        raw.positions.push(p);
     }
     let mut corners = Vec::new();
     for f in 0..faces {

@@ -7,7 +7,7 @@
 use embedding::Point3;
 
 use super::obj::quote;
-use super::{ImportError, Location, MeshFormat, RawMesh, parse_f64, text_lines};
+use super::{ImportError, Location, MeshFormat, RawMesh, text_lines, text_vertex};
 
 const FORMAT: MeshFormat = MeshFormat::Stl;
 
@@ -120,34 +120,14 @@ fn ascii(bytes: &[u8]) -> Result<RawMesh, ImportError> {
             "facet" if in_solid && facet.is_none() => facet = Some(Vec::with_capacity(3)),
             "outer" | "endloop" if facet.is_some() => {}
             "vertex" if facet.is_some() => {
-                let mut xyz = [0.0; 3];
-                for (k, slot) in xyz.iter_mut().enumerate() {
-                    let token = tokens.next().ok_or_else(|| {
-                        error(
-                            number,
-                            format!("a vertex needs three coordinates, found {k}"),
-                        )
-                    })?;
-                    *slot = parse_f64(token).ok_or_else(|| {
-                        error(number, format!("`{}` is not a number", quote(token)))
-                    })?;
-                }
-                if !xyz.iter().all(|x| x.is_finite()) {
-                    return Err(ImportError::NonFinite {
-                        vertex: raw.positions.len(),
-                        at: Location::Line(number),
-                        x: xyz[0],
-                        y: xyz[1],
-                        z: xyz[2],
-                    });
-                }
+                let p = text_vertex(&mut tokens, FORMAT, number, "a vertex", raw.positions.len())?;
                 if raw.positions.len() >= u32::MAX as usize {
                     return Err(error(number, "too many vertices".into()));
                 }
                 if let Some(corners) = facet.as_mut() {
                     corners.push(raw.positions.len() as u32);
                 }
-                raw.positions.push(Point3::from(xyz));
+                raw.positions.push(p);
             }
             "endfacet" if facet.is_some() => {
                 let corners = facet.take().unwrap_or_default();
