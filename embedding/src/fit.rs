@@ -442,11 +442,24 @@ pub fn parameterize(
     }
 }
 
-/// Genus 0: ζ = (x + iy)/(R + z) on the round sphere, north cap around ζ = 0, south around ∞.
+/// Genus 0: the round sphere's own points.
 fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
+    Parameterization {
+        points: stereographic_points(atlas, &mesh.positions),
+        disk: None,
+        flat: Vec::new(),
+        lifts: Vec::new(),
+        copies: Vec::new(),
+        folded: 0,
+        sweeps: 0,
+    }
+}
+
+/// The genus-0 atlas's chart points of points on a sphere round the origin: ζ = (x + iy)/(R + z),
+/// the north cap around ζ = 0 (z ≥ 0), the south around ∞.
+pub(crate) fn stereographic_points(atlas: &Atlas, sphere: &[Point3]) -> Vec<ChartPoint> {
     let (north, south) = (&atlas.charts()[0], &atlas.charts()[1]);
-    let points = mesh
-        .positions
+    sphere
         .iter()
         .map(|p| {
             let r = p.coords.norm();
@@ -458,16 +471,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
                 ChartPoint::new(south.id(), xy.conj() / ((r - p.z) * south.scale()))
             }
         })
-        .collect();
-    Parameterization {
-        points,
-        disk: None,
-        flat: Vec::new(),
-        lifts: Vec::new(),
-        copies: Vec::new(),
-        folded: 0,
-        sweeps: 0,
-    }
+        .collect()
 }
 
 fn flatten(
@@ -738,7 +742,7 @@ impl Lifts {
     pub(crate) fn reweight(&mut self, stretch: &[f64]) {
         for list in &mut self.neighbours {
             for (w, u, _) in list.iter_mut() {
-                *w /= stretch[*u as usize].powf(STRETCH_EXPONENT);
+                *w /= stretch_divisor(stretch[*u as usize]);
             }
         }
     }
@@ -770,6 +774,12 @@ impl Lifts {
             })
             .count()
     }
+}
+
+/// What a neighbour's weight is divided by where the map stretches the surface by `stretch` there
+/// (see [`STRETCH_EXPONENT`]).
+pub(crate) fn stretch_divisor(stretch: f64) -> f64 {
+    stretch.powf(STRETCH_EXPONENT)
 }
 
 /// For each polygon corner c, the group element taking corner 0's neighbourhood onto corner c's: the

@@ -33,6 +33,7 @@ pub mod model;
 pub mod quality;
 pub mod remesh;
 pub mod spline_surface;
+mod sphere_map;
 pub mod stencil;
 pub mod surface;
 

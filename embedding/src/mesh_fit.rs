@@ -1,5 +1,9 @@
-//! Fitting a user's mesh: any closed, oriented, manifold triangle mesh of genus 1 to 64 becomes a
+//! Fitting a user's mesh: any closed, oriented, manifold triangle mesh of genus 0 to 64 becomes a
 //! model, through the same relaxation, checks and least-squares fit as [`crate::fit`]'s plates.
+//!
+//! Genus 0 is mapped onto the sphere ([`crate::sphere_map`]: Floater's map of the mesh less one
+//! triangle, lifted to the sphere, relaxed there with Möbius centering). The rest of this module is
+//! about genus ≥ 1.
 //!
 //! A plate comes with its canonical loops; a user's mesh does not. Instead of cutting the mesh along
 //! canonical loops (which would have to be found, re-routed and made disjoint on the mesh), the map is
@@ -24,15 +28,16 @@
 
 use std::sync::Arc;
 
-use charts::{Atlas, Lft, ModelPoint, Polygon};
+use charts::{Atlas, ChartPoint, Lft, ModelPoint, Polygon};
 use mesh::HalfEdgeMesh;
 use mesh::schema::{self, Letter, LoopSystem};
 use num_complex::Complex64;
 
 use crate::fit::{
     FitSettings, FitStage, Lifts, Parameterization, RELAX_TOLERANCE, deepest, diagonal, fit,
-    vertex_areas,
+    stereographic_points, vertex_areas,
 };
+use crate::sphere_map::{EXTRA_ROUNDS, sphere_map};
 use crate::spline_surface::Surface;
 use crate::surface::{Layout, Point3, SplineSettings};
 use crate::{EmbeddingError, floater};
@@ -71,8 +76,8 @@ pub struct LoopReport {
 /// Candidate base vertices tried: the one whose generator loops are shortest in total is used.
 const BASE_CANDIDATES: usize = 8;
 
-/// Fits a model to a closed, oriented, manifold, connected triangle mesh of genus ≥ 1 (counter-
-/// clockwise seen from outside). Refuses more than [`crate::fit::MAX_FIT_TRIANGLES`] triangles.
+/// Fits a model to a closed, oriented, manifold, connected triangle mesh of any genus the atlas has
+/// (counter-clockwise seen from outside). Refuses more than [`crate::fit::MAX_FIT_TRIANGLES`] triangles.
 pub fn mesh_model(
     positions: &[Point3],
     triangles: &[[u32; 3]],
@@ -95,15 +100,112 @@ pub fn mesh_model(
     let genus = topology
         .genus
         .ok_or_else(|| fail("the mesh has no genus".into()))?;
-    if genus == 0 {
-        return Err(fail("genus 0 meshes are not fitted yet".into()));
-    }
     let atlas = Arc::new(Atlas::new(genus)?);
     let layout = Layout::new(&atlas, settings)?;
-    let polygon = atlas.polygon().expect("genus ≥ 1 has a polygon");
-    let hyperbolic = genus >= 2;
-
     let areas = vertex_areas(positions, triangles);
+    let mapped = match atlas.polygon() {
+        None => map_to_sphere(&atlas, positions, triangles, &areas, fit_settings, progress)?,
+        Some(polygon) => map_to_polygon(
+            &atlas,
+            polygon,
+            &he,
+            positions,
+            triangles,
+            &areas,
+            fit_settings,
+            progress,
+        )?,
+    };
+
+    progress(FitStage::Fitting);
+    let points = mapped.points;
+    let control = fit(&layout, &points, positions, &areas, fit_settings)?;
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for (p, target) in points.iter().zip(positions) {
+        let e = (layout.eval(&control, *p).pos - target).norm();
+        sum += e * e;
+        max = max.max(e);
+    }
+    let surface = Surface::new(Arc::clone(&atlas), settings, control)?;
+    Ok(MeshFit {
+        surface,
+        genus,
+        parameterization: Parameterization {
+            points,
+            disk: None,
+            flat: Vec::new(),
+            lifts: mapped.lifts,
+            copies: Vec::new(),
+            folded: mapped.folded,
+            sweeps: mapped.sweeps,
+        },
+        loops: mapped.loops,
+        rms_residual: (sum / positions.len() as f64).sqrt(),
+        max_residual: max,
+        mesh_diagonal: diagonal(positions),
+    })
+}
+
+/// Every mesh vertex's surface point, and how the map that gave them went.
+struct Mapped {
+    points: Vec<ChartPoint>,
+    /// One lift per vertex in the model (Poincaré disk or plane); empty for the sphere.
+    lifts: Vec<Complex64>,
+    folded: usize,
+    sweeps: usize,
+    loops: LoopReport,
+}
+
+/// Genus 0: the mesh mapped onto the unit sphere ([`sphere_map`]), read in the sphere's two caps.
+fn map_to_sphere(
+    atlas: &Atlas,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    areas: &[f64],
+    fit_settings: FitSettings,
+    progress: &dyn Fn(FitStage),
+) -> Result<Mapped, EmbeddingError> {
+    progress(FitStage::Relaxing {
+        round: 1,
+        rounds: fit_settings.stretch_rounds + EXTRA_ROUNDS + 1,
+    });
+    let map = sphere_map(
+        positions,
+        triangles,
+        areas,
+        fit_settings.sweeps,
+        fit_settings.stretch_rounds,
+        RELAX_TOLERANCE,
+    )?;
+    let sphere: Vec<Point3> = map.points.iter().map(|&v| Point3::from(v)).collect();
+    Ok(Mapped {
+        points: stereographic_points(atlas, &sphere),
+        lifts: Vec::new(),
+        folded: map.folded,
+        sweeps: map.sweeps,
+        loops: LoopReport {
+            base: 0,
+            paths: Vec::new(),
+            relation: Vec::new(),
+            canonical: Vec::new(),
+            closure_error: 0.0,
+        },
+    })
+}
+
+/// Genus ≥ 1: the equivariant Tutte map of the best of a few markings, relaxed and reweighted.
+#[allow(clippy::too_many_arguments)]
+fn map_to_polygon(
+    atlas: &Atlas,
+    polygon: &Polygon,
+    he: &HalfEdgeMesh,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    areas: &[f64],
+    fit_settings: FitSettings,
+    progress: &dyn Fn(FitStage),
+) -> Result<Mapped, EmbeddingError> {
+    let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
     let length =
         |h: u32| (positions[he.target(h) as usize] - positions[he.origin(h) as usize]).norm();
     let Marked {
@@ -111,7 +213,7 @@ pub fn mesh_model(
         words,
         closure_error,
         mut lifts,
-    } = best_marking(&he, positions, triangles, &areas, polygon, &length)?;
+    } = best_marking(he, positions, triangles, areas, polygon, &length)?;
     let rounds = fit_settings.stretch_rounds + 1;
     let mut sweeps = 0;
     for round in 1..=rounds {
@@ -126,43 +228,23 @@ pub fn mesh_model(
     let points = lifts
         .home
         .iter()
-        .map(|&z| deepest(&atlas, ModelPoint(z)))
+        .map(|&z| deepest(atlas, ModelPoint(z)))
         .collect::<Result<Vec<_>, _>>()?;
-
-    progress(FitStage::Fitting);
-    let control = fit(&layout, &points, positions, &areas, fit_settings)?;
-    let (mut sum, mut max) = (0.0, 0.0f64);
-    for (p, target) in points.iter().zip(positions) {
-        let e = (layout.eval(&control, *p).pos - target).norm();
-        sum += e * e;
-        max = max.max(e);
-    }
-    let surface = Surface::new(Arc::clone(&atlas), settings, control)?;
     let loops = LoopReport {
         base: system.base,
         paths: (0..system.generators.len())
-            .map(|i| system.loop_path(&he, i))
+            .map(|i| system.loop_path(he, i))
             .collect(),
         relation: system.relation.clone(),
         canonical: words,
         closure_error,
     };
-    Ok(MeshFit {
-        surface,
-        genus,
-        parameterization: Parameterization {
-            points,
-            disk: None,
-            flat: Vec::new(),
-            lifts: lifts.home,
-            copies: Vec::new(),
-            folded,
-            sweeps,
-        },
+    Ok(Mapped {
+        points,
+        lifts: lifts.home,
+        folded,
+        sweeps,
         loops,
-        rms_residual: (sum / positions.len() as f64).sqrt(),
-        max_residual: max,
-        mesh_diagonal: diagonal(positions),
     })
 }
 
@@ -211,6 +293,11 @@ fn best_marking(
         let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
         lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
         let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
+        tracing::debug!(
+            base = system.base,
+            score,
+            "marking screened (area-weighted mean of squared log stretch)"
+        );
         if best.as_ref().is_none_or(|(s, _)| score < *s) {
             let marked = Marked {
                 system,

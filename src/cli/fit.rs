@@ -113,14 +113,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     emit(&report, args.json)
 }
 
-/// Genus 0 and meshes beyond the fit's size are refused before any work.
+/// Meshes beyond the fit's size are refused before any work.
 fn refuse_unfittable(path: &Path, valid: &ValidMesh) -> anyhow::Result<()> {
-    if valid.genus == 0 {
-        anyhow::bail!(
-            "cannot fit {}: it has genus 0 (a sphere), which `ntori fit` does not fit yet; `ntori new --genus 0` makes a sphere",
-            path.display()
-        );
-    }
     if valid.triangles.len() > MAX_FIT_TRIANGLES {
         anyhow::bail!(
             "cannot fit {}: it has {} triangles, and the fit takes at most {MAX_FIT_TRIANGLES} (decimate it first)",
@@ -234,12 +228,15 @@ impl Report for FitReport<'_> {
                 self.output.display()
             )
         };
-        format!(
-            "read {}{notes}\nloops: {} through vertex {}, canonical words of up to {longest} letters\n",
-            i.path,
-            self.loops.loop_edges.len(),
-            self.loops.base_vertex,
-        ) + &self.fit.to_text()
-            + &outcome
+        let loops = if self.loops.loop_edges.is_empty() {
+            "loops: none (genus 0: mapped onto the sphere)".to_string()
+        } else {
+            format!(
+                "loops: {} through vertex {}, canonical words of up to {longest} letters",
+                self.loops.loop_edges.len(),
+                self.loops.base_vertex,
+            )
+        };
+        format!("read {}{notes}\n{loops}\n", i.path) + &self.fit.to_text() + &outcome
     }
 }
