@@ -32,8 +32,8 @@ pub mod mesh_fit;
 pub mod model;
 pub mod quality;
 pub mod remesh;
-pub mod spline_surface;
 mod sphere_map;
+pub mod spline_surface;
 pub mod stencil;
 pub mod surface;
 
