@@ -43,20 +43,18 @@ fn fit_refuses_an_open_mesh_and_writes_nothing() {
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
     )
     .unwrap();
-    for (mesh, message) in [(&open, "the mesh is not closed: it has 1 hole")] {
-        ntori()
-            .arg("fit")
-            .arg(mesh)
-            .arg("-o")
-            .arg(&out)
-            .assert()
-            .failure()
-            .stderr(predicate::str::contains(message))
-            .stderr(predicate::str::contains(
-                mesh.file_name().unwrap().to_str().unwrap(),
-            ));
-        assert!(!out.exists());
-    }
+    ntori()
+        .arg("fit")
+        .arg(&open)
+        .arg("-o")
+        .arg(&out)
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains(
+            "the mesh is not closed: it has 1 hole",
+        ))
+        .stderr(predicate::str::contains("open.obj"));
+    assert!(!out.exists());
 }
 
 #[test]
