@@ -578,7 +578,8 @@ fn bad_input_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
         .unwrap();
     let constant64 = constant_model(dir, 64);
     let constant = constant_model(dir, 1);
-    vec![
+    let meshes = mesh_fixtures(dir);
+    let mut fixtures: Vec<(String, std::path::PathBuf)> = vec![
         ("MODEL".into(), model),
         ("CONSTANT64".into(), constant64),
         ("CONSTANT".into(), constant),
@@ -630,7 +631,270 @@ fn bad_input_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
         ("FIFO".into(), fifo),
         ("OUT".into(), dir.join("out")),
         ("DIR".into(), dir.to_path_buf()),
+    ];
+    fixtures.extend(meshes);
+    fixtures
+}
+
+// ------------------------------------------------------------------- meshes for `ntori fit`
+
+/// A tetrahedron: its corners and its triangles (outward).
+const TETRA_POINTS: [[f64; 3]; 4] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+];
+const TETRA: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+
+/// A mesh as positions and triangles (vertex indices from 0).
+type Mesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// OBJ text of a mesh, coordinates rounded to 4 decimals (so messages quote short numbers).
+fn obj_text((positions, triangles): &Mesh) -> String {
+    let mut text = String::new();
+    for p in positions {
+        let [x, y, z] = p.map(|c| (c * 1e4).round() / 1e4 + 0.0);
+        text += &format!("v {x} {y} {z}\n");
+    }
+    for t in triangles {
+        text += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    text
+}
+
+/// A grid of n × m vertices over the square [0, 2π)², each quad cut in two; `vertex(i, j)` gives
+/// the index of grid point (i, j) for i in 0..=n, j in 0..=m (so the caller says how the sides are
+/// glued), `position(u, v)` the point.
+fn glued_grid(
+    n: u32,
+    m: u32,
+    vertex: impl Fn(u32, u32) -> u32,
+    position: impl Fn(f64, f64) -> [f64; 3],
+) -> Mesh {
+    let tau = std::f64::consts::TAU;
+    let positions = (0..n)
+        .flat_map(|i| (0..m).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            position(
+                tau * f64::from(i) / f64::from(n),
+                tau * f64::from(j) / f64::from(m),
+            )
+        })
+        .collect();
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            let (a, b, c, d) = (
+                vertex(i, j),
+                vertex(i + 1, j),
+                vertex(i + 1, j + 1),
+                vertex(i, j + 1),
+            );
+            triangles.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    (positions, triangles)
+}
+
+/// A torus of 8 × 6 vertices (96 triangles, radii 2 and 1): a valid genus-1 mesh.
+fn torus() -> Mesh {
+    let (n, m) = (8, 6);
+    glued_grid(
+        n,
+        m,
+        |i, j| (i % n) * m + j % m,
+        |u, v| {
+            let w = 2.0 + v.cos();
+            [w * u.cos(), w * u.sin(), v.sin()]
+        },
+    )
+}
+
+/// A Klein bottle (the figure-8 immersion, 12 × 8 vertices): closed and manifold, but going once
+/// round in u turns the tube over (v → −v), so its faces cannot agree on a side.
+fn klein_bottle() -> Mesh {
+    let (n, m) = (12, 8);
+    let vertex = move |i: u32, j: u32| {
+        if i == n {
+            (m - j % m) % m
+        } else {
+            i * m + j % m
+        }
+    };
+    glued_grid(n, m, vertex, |u, v| {
+        let v = v + 0.3;
+        let w = 3.0 + (u / 2.0).cos() * v.sin() - (u / 2.0).sin() * (2.0 * v).sin();
+        [
+            w * u.cos(),
+            w * u.sin(),
+            (u / 2.0).sin() * v.sin() + (u / 2.0).cos() * (2.0 * v).sin(),
+        ]
+    })
+}
+
+/// Binary STL of triangles given by their corners, after an 80-byte header that begins with
+/// `header`.
+fn binary_stl(header: &[u8], triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut bytes = header.to_vec();
+    bytes.resize(80, 0);
+    bytes.extend((triangles.len() as u32).to_le_bytes());
+    for t in triangles {
+        bytes.extend([0u8; 12]);
+        for c in t.iter().flatten() {
+            bytes.extend(c.to_le_bytes());
+        }
+        bytes.extend([0u8; 2]);
+    }
+    bytes
+}
+
+/// The mesh files docs/bad-inputs.md's section on `ntori fit` names (`$MESH_…`), made in `dir`.
+fn mesh_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
+    let file = |name: &str, contents: &[u8]| {
+        let path = dir.join(name);
+        std::fs::write(&path, contents).unwrap();
+        path
+    };
+    let tetra: Mesh = (TETRA_POINTS.to_vec(), TETRA.to_vec());
+    let (torus_points, torus_triangles) = torus();
+    // Two tetrahedra sharing the edge from vertex 0 to vertex 1 (four faces on it).
+    let fin: Mesh = (
+        [&TETRA_POINTS[..], &[[0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]].concat(),
+        [&TETRA[..], &[[0, 1, 4], [0, 5, 1], [1, 5, 4], [0, 4, 5]]].concat(),
+    );
+    // Two square pyramids (closed), their tips at vertex 0.
+    let cones: Mesh = (
+        vec![
+            [0.0, 0.0, 0.0],
+            [-1.0, -1.0, 1.0],
+            [1.0, -1.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [-1.0, 1.0, 1.0],
+            [-1.0, -1.0, -1.0],
+            [1.0, -1.0, -1.0],
+            [1.0, 1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+        ],
+        vec![
+            [0, 2, 1],
+            [0, 3, 2],
+            [0, 4, 3],
+            [0, 1, 4],
+            [1, 2, 3],
+            [1, 3, 4],
+            [0, 5, 6],
+            [0, 6, 7],
+            [0, 7, 8],
+            [0, 8, 5],
+            [5, 7, 6],
+            [5, 8, 7],
+        ],
+    );
+    // The torus less two triangles far apart: two holes.
+    let mut open = torus();
+    open.1.remove(40);
+    open.1.remove(0);
+    // The torus and, apart from it, a tetrahedron.
+    let two: Mesh = (
+        [
+            &torus_points[..],
+            &TETRA_POINTS.map(|p| [p[0] + 9.0, p[1], p[2]])[..],
+        ]
+        .concat(),
+        [
+            &torus_triangles[..],
+            &TETRA.map(|t| t.map(|v| v + torus_points.len() as u32))[..],
+        ]
+        .concat(),
+    );
+    // The torus with one more triangle, whose vertex repeats.
+    let mut sliver = torus();
+    sliver.1.push([0, 0, 1]);
+    // A tetrahedron whose corners lie on a line: every triangle has zero area.
+    let flat: Mesh = (
+        (0..4).map(|k| [f64::from(k), 0.0, 0.0]).collect(),
+        TETRA.to_vec(),
+    );
+    let tetra_corners: Vec<[[f32; 3]; 3]> = tetra
+        .1
+        .iter()
+        .map(|t| t.map(|v| tetra.0[v as usize].map(|c| c as f32)))
+        .collect();
+    let mut infinite = tetra_corners.clone();
+    infinite[1][1][1] = f32::INFINITY;
+    let stl = binary_stl(b"binary", &tetra_corners);
+    let solid_stl = binary_stl(b"solid exported by a tool", &tetra_corners);
+    let three = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let mesh_dir = dir.join("dir.obj");
+    std::fs::create_dir(&mesh_dir).unwrap();
+    let big = dir.join("big.stl");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(ntori::io::import::MAX_MESH_BYTES + 1)
+        .unwrap();
+    let mut glb = b"glTF".to_vec();
+    for word in [2u32, 4000, 20, 0x4E4F_534A] {
+        glb.extend(word.to_le_bytes());
+    }
+    glb.extend(b"{\"asset\":{\"version\"");
+    let mut no_magic = glb.clone();
+    no_magic[3] = b'X';
+    [
+        ("TORUS", file("torus.obj", obj_text(&torus()).as_bytes())),
+        ("DIR", mesh_dir),
+        ("BIG", big),
+        ("EMPTY", file("empty.stl", b"")),
+        ("UNKNOWN", file("torus.3ds", obj_text(&torus()).as_bytes())),
+        (
+            "NUMBER",
+            file("number.obj", b"v 0 0 0\nv 1,5 0 0\nv 0 1 0\nf 1 2 3\n"),
+        ),
+        (
+            "INDEX",
+            file("index.obj", format!("{three}f 1 2 9\n").as_bytes()),
+        ),
+        (
+            "TWO_CORNERS",
+            file("two-corners.obj", format!("{three}f 1 2\n").as_bytes()),
+        ),
+        (
+            "NAN",
+            file("nan.obj", b"v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n"),
+        ),
+        ("INFINITE", file("infinite.stl", &binary_stl(b"binary", &infinite))),
+        ("STL_CUT", file("cut.stl", &stl[..stl.len() - 30])),
+        (
+            "STL_SOLID_CUT",
+            file("solid-cut.stl", &solid_stl[..solid_stl.len() - 30]),
+        ),
+        (
+            "STL_TEXT",
+            file(
+                "text.stl",
+                b"solid x\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\n hello world\nendsolid x\n",
+            ),
+        ),
+        (
+            "PLY_HEADER",
+            file(
+                "header.ply",
+                b"ply\nformat ascii 1.0\nelement vertex 3\nproperty flaot x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
+            ),
+        ),
+        ("GLB_MAGIC", file("magic.glb", &no_magic)),
+        ("GLB_CUT", file("cut.glb", &glb)),
+        ("OPEN", file("open.obj", obj_text(&open).as_bytes())),
+        ("FIN", file("fin.obj", obj_text(&fin).as_bytes())),
+        ("CONES", file("cones.obj", obj_text(&cones).as_bytes())),
+        ("KLEIN", file("klein.obj", obj_text(&klein_bottle()).as_bytes())),
+        ("TWO", file("two.obj", obj_text(&two).as_bytes())),
+        ("SLIVER", file("sliver.obj", obj_text(&sliver).as_bytes())),
+        ("FLAT", file("flat.obj", obj_text(&flat).as_bytes())),
     ]
+    .into_iter()
+    .map(|(name, path)| (format!("MESH_{name}"), path))
+    .collect()
 }
 
 /// One row of a table in docs/bad-inputs.md: the command's words, the exit status, the message.
@@ -674,8 +938,17 @@ fn bad_input_rows() -> Vec<Row> {
 fn bad_inputs_table_holds() {
     let dir = tempfile::tempdir().unwrap();
     let fixtures = bad_input_fixtures(dir.path());
+    let model = dir.path().join("model.json");
+    let model_bytes = std::fs::read(&model).unwrap();
     let rows = bad_input_rows();
-    assert!(rows.len() >= 37, "the table has {} rows", rows.len());
+    assert!(rows.len() >= 71, "the table has {} rows", rows.len());
+    // Where one fixture's name begins another's ($CONSTANT, $CONSTANT64), the longer comes first,
+    // since the first that matches is used.
+    for (i, (a, _)) in fixtures.iter().enumerate() {
+        for (b, _) in &fixtures[i + 1..] {
+            assert!(!b.starts_with(a.as_str()), "${b} must come before ${a}");
+        }
+    }
     for row in rows {
         let args: Vec<String> = row
             .command
@@ -714,7 +987,93 @@ fn bad_inputs_table_holds() {
         );
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
-    // Nothing was written where a row refused.
-    assert!(!dir.path().join("out.obj").exists() && !dir.path().join("out.png").exists());
+    // Nothing was written where a row refused, nor replaced.
+    for out in ["out.obj", "out.png", "out.json"] {
+        assert!(!dir.path().join(out).exists(), "{out} was written");
+    }
     assert!(is_fifo(&dir.path().join("fifo")));
+    assert_eq!(std::fs::read(&model).unwrap(), model_bytes);
+}
+
+/// A refused `ntori fit` leaves an existing output byte for byte as it was (even with --force) and
+/// makes no file where there was none: not the output, and no temporary file beside it.
+#[test]
+fn a_failing_fit_leaves_its_output_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let meshes = mesh_fixtures(dir.path());
+    let mesh = |name: &str| {
+        &meshes
+            .iter()
+            .find(|(n, _)| n == &format!("MESH_{name}"))
+            .unwrap()
+            .1
+    };
+    let out = tempfile::tempdir().unwrap();
+    let existing = out.path().join("existing.json");
+    // Not JSON, not text: any rewrite would show.
+    let before: Vec<u8> = (0..=255u8).rev().chain(*b"mine").collect();
+    std::fs::write(&existing, &before).unwrap();
+    let absent = out.path().join("absent.json");
+    let listing = || {
+        let mut names: Vec<_> = std::fs::read_dir(out.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        names
+    };
+    let names = listing();
+    for (name, message) in [
+        ("OPEN", "the mesh is not closed: it has 2 holes"),
+        ("KLEIN", "the mesh is not orientable"),
+        ("CONES", "non-manifold vertex"),
+        ("TWO", "pass --largest"),
+        ("NAN", "not a finite number"),
+        ("STL_CUT", "binary STL of 4 triangles"),
+        ("EMPTY", "the file is empty"),
+    ] {
+        for (output, force) in [(&existing, true), (&absent, false), (&absent, true)] {
+            let mut command = ntori();
+            command
+                .arg("fit")
+                .arg(mesh(name))
+                .arg("-q")
+                .arg("-o")
+                .arg(output);
+            if force {
+                command.arg("--force");
+            }
+            command
+                .timeout(std::time::Duration::from_secs(120))
+                .assert()
+                .code(1)
+                .stderr(predicate::str::contains(message))
+                .stderr(predicate::str::contains("panicked").not());
+            assert_eq!(std::fs::read(&existing).unwrap(), before, "{name}");
+            assert!(!absent.exists(), "{name}: {} written", absent.display());
+            assert_eq!(listing(), names, "{name}: files appeared");
+        }
+        // Without --force an existing output is refused before the mesh is read.
+        ntori()
+            .arg("fit")
+            .arg(mesh(name))
+            .args(["-q", "-o"])
+            .arg(&existing)
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains("it exists; pass --force"));
+        assert_eq!(std::fs::read(&existing).unwrap(), before, "{name}");
+    }
+    // Nor is the input touched when the output names it.
+    let torus = mesh("TORUS");
+    let input = std::fs::read(torus).unwrap();
+    ntori()
+        .arg("fit")
+        .arg(torus)
+        .args(["-q", "--force", "-o"])
+        .arg(torus)
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("it is the input"));
+    assert_eq!(std::fs::read(torus).unwrap(), input);
 }

@@ -463,8 +463,44 @@ fn reading_errors_say_what_and_where() {
         .to_string();
     eprintln!("{text}");
     assert!(text.contains("none.OBJ: no such file"), "{text}");
+    // What the path is comes before its extension.
     let text = read_mesh(dir.path()).unwrap_err().to_string();
+    assert!(
+        text.contains("it is a directory, not a regular file"),
+        "{text}"
+    );
+    let bare = dir.path().join("mesh");
+    std::fs::write(&bare, "v 0 0 0\n").unwrap();
+    let text = read_mesh(&bare).unwrap_err().to_string();
     assert!(text.contains("no extension"), "{text}");
+    // An empty file is called empty, whatever its format.
+    for format in [
+        MeshFormat::Obj,
+        MeshFormat::Ply,
+        MeshFormat::Stl,
+        MeshFormat::Glb,
+    ] {
+        assert_eq!(read_error(b"", format), "the file is empty (0 bytes)");
+    }
+    // A binary STL cut short is not taken for text because its header begins with `solid`.
+    let mut solid = b"solid made by a tool".to_vec();
+    solid.resize(90, 0);
+    solid[80] = 2;
+    assert_eq!(
+        read_error(&solid, MeshFormat::Stl),
+        "not a valid STL file (byte 80): binary STL of 2 triangles has 184 bytes, but the file has 90"
+    );
+    // ply-rs-bw's several-line errors become one line, with the line number as the location.
+    let ply = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty flaot x\nend_header\n";
+    assert_eq!(
+        read_error(ply, MeshFormat::Ply),
+        "not a valid PLY file (line 4): couldn't parse line: `property flaot x`"
+    );
+    // A GLB whose magic is wrong is not parsed as JSON.
+    assert_eq!(
+        read_error(b"glTX\x02\0\0\0", MeshFormat::Glb),
+        "not a valid glTF file (byte 0): it begins with `glTX`, but binary glTF (GLB) begins with `glTF` and glTF JSON with `{`"
+    );
     // A format error names the file once.
     let bad = dir.path().join("bad.off");
     std::fs::write(&bad, "OFF\n3 1 0\n0 0 0\n1 0 x\n").unwrap();
@@ -528,9 +564,10 @@ fn reading_errors_say_what_and_where() {
         b"{\"asset\": {\"version\": \"2.0\"},\n \"meshes\": [}",
         MeshFormat::Glb,
     );
-    assert!(
-        text.starts_with("not a valid glTF file (line 2, column 13)"),
-        "{text}"
+    // The place once, not again at the end of serde_json's message.
+    assert_eq!(
+        text,
+        "not a valid glTF file (line 2, column 13): expected value"
     );
     let text = read_error(b"4OFF\n", MeshFormat::Off);
     assert_eq!(
@@ -593,6 +630,19 @@ fn degenerate_triangles_are_located() {
         text,
         "the mesh has 1 degenerate triangle (zero area or a repeated vertex); the first is triangle 1, vertices 0 at (0, 0, 0), 1 at (1, 0, 0), 3 at (0.5, 0, 0)"
     );
+    // Every triangle: said so, not as one more count.
+    let mut point = tetra();
+    point.positions.fill(Point3::new(1.0, 2.0, 3.0));
+    let text = message(validate(point, false));
+    assert!(
+        text.starts_with("all 4 triangles of the mesh are degenerate (zero area or a repeated vertex), so it has no surface to fit; the first is triangle 0"),
+        "{text}"
+    );
+    let text = message(validate(imported(&TETRA_POINTS[..3], &[[0, 1, 1]]), false));
+    assert!(
+        text.starts_with("the mesh's one triangle is degenerate (zero area or a repeated vertex), so it has no surface to fit"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -635,10 +685,18 @@ fn non_manifold_vertices_are_located() {
 fn holes_are_located() {
     let mut mesh = slab(1);
     mesh.triangles.drain(0..2);
-    let text = message(validate(mesh, false));
+    let text = message(validate(mesh.clone(), false));
     assert_eq!(
         text,
         "the mesh is not closed: it has 1 hole (boundary loop); the first runs through vertex 3 at (1, 0, 1) and has 4 edges"
+    );
+    // Every hole is located, up to four of them.
+    let last = mesh.triangles.len() - 2;
+    mesh.triangles.drain(last..);
+    let text = message(validate(mesh, false));
+    assert!(
+        text.starts_with("the mesh is not closed: it has 2 holes (boundary loops); the first runs through vertex 3 at (1, 0, 1) and has 4 edges; the other runs through vertex "),
+        "{text}"
     );
 }
 
@@ -841,6 +899,11 @@ fn fuzz_mesh_readers() {
             Err(e) => {
                 let text = e.to_string();
                 proptest::prop_assert!(text.len() <= 1_000, "a long message: {}", text);
+                proptest::prop_assert!(
+                    !text.contains('\n'),
+                    "a message of several lines: {}",
+                    text
+                );
                 format!("{e:?}")
                     .split([' ', '(', '{'])
                     .next()

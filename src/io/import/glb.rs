@@ -90,18 +90,48 @@ fn container(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), ImportError> {
 }
 
 pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ImportError> {
-    let (json, bin) = if bytes.starts_with(b"glTF") {
+    let binary = bytes.starts_with(b"glTF");
+    let text = bytes
+        .strip_prefix(b"\xEF\xBB\xBF")
+        .unwrap_or(bytes)
+        .trim_ascii_start();
+    if !binary && !text.starts_with(b"{") {
+        let start = &bytes[..bytes.len().min(4)];
+        return Err(parse_error(
+            Location::Byte(0),
+            format!(
+                "it begins with `{}`, but binary glTF (GLB) begins with `glTF` and glTF JSON with `{{`",
+                quote(&start.escape_ascii().to_string())
+            ),
+        ));
+    }
+    let (json, bin) = if binary {
         container(bytes)?
     } else {
         (bytes, None)
     };
     let root = Root::from_slice(json).map_err(|e| {
-        let at = if bytes.starts_with(b"glTF") {
-            Location::Unknown
+        // serde_json ends its message with the place; the location says it once.
+        let message = e.to_string();
+        let place = format!(" at line {} column {}", e.line(), e.column());
+        if binary {
+            parse_error(
+                Location::Unknown,
+                format!(
+                    "the JSON chunk: {}",
+                    message.replace(
+                        &place,
+                        &format!(" (line {}, column {})", e.line(), e.column())
+                    )
+                ),
+            )
         } else {
-            Location::LineColumn(e.line(), e.column())
-        };
-        parse_error(at, format!("{e}"))
+            let message = message.strip_suffix(&place).unwrap_or(&message);
+            parse_error(
+                Location::LineColumn(e.line(), e.column()),
+                message.to_owned(),
+            )
+        }
     })?;
     if let Some(ext) = root.extensions_required.first() {
         return Err(unsupported(

@@ -170,6 +170,35 @@ fn list_sizes(sizes: &[usize]) -> String {
     }
 }
 
+/// Holes after the first that a "not closed" message names.
+const MORE_HOLES_NAMED: usize = 3;
+
+/// "; the others run through vertex 7 at (…) (4 edges), vertex 9 at (…) (3 edges) and 2 more":
+/// the holes after the first, or nothing when there is one.
+fn list_holes(others: &[(u32, Place, usize)], loops: usize) -> String {
+    if others.is_empty() {
+        return String::new();
+    }
+    let mut named: Vec<String> = others
+        .iter()
+        .map(|(v, p, n)| format!("vertex {v} at {p} ({})", plural(*n, "edge", "edges")))
+        .collect();
+    let rest = loops.saturating_sub(1 + others.len());
+    if rest > 0 {
+        named.push(format!("{rest} more"));
+    }
+    let list = match named.split_last() {
+        Some((last, init)) if !init.is_empty() => format!("{} and {last}", init.join(", ")),
+        _ => named.join(""),
+    };
+    let verb = if loops == 2 {
+        "the other runs"
+    } else {
+        "the others run"
+    };
+    format!("; {verb} through {list}")
+}
+
 fn plural(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
@@ -197,7 +226,7 @@ pub enum ImportError {
     )]
     UnknownFormat { path: PathBuf, extension: String },
     /// Anything below, found in this file ([`read_mesh`] names the file once).
-    #[error("{}: {error}", .path.display())]
+    #[error("cannot read {}: {error}", .path.display())]
     InFile {
         path: PathBuf,
         error: Box<ImportError>,
@@ -232,6 +261,11 @@ pub enum ImportError {
         y: f64,
         z: f64,
     },
+    #[error(
+        "the file is empty{}",
+        if *.bytes == 0 { " (0 bytes)".to_owned() } else { format!(": its {} bytes are all white space", .bytes) }
+    )]
+    Blank { bytes: usize },
     #[error("the {format} file holds no {what}")]
     Empty {
         format: MeshFormat,
@@ -254,12 +288,21 @@ pub enum ImportError {
         sizes: Vec<usize>,
     },
     #[error(
-        "the mesh has {} (zero area or a repeated vertex); the first is triangle {triangle}, vertices {} at {}, {} at {}, {} at {}",
-        plural(*.count, "degenerate triangle", "degenerate triangles"),
+        "{} (zero area or a repeated vertex){}; the first is triangle {triangle}, vertices {} at {}, {} at {}, {} at {}",
+        if .count == .total && *.total == 1 {
+            "the mesh's one triangle is degenerate".to_owned()
+        } else if .count == .total {
+            format!("all {} triangles of the mesh are degenerate", .count)
+        } else {
+            format!("the mesh has {}", plural(*.count, "degenerate triangle", "degenerate triangles"))
+        },
+        if .count == .total { ", so it has no surface to fit" } else { "" },
         .vertices[0], .positions[0], .vertices[1], .positions[1], .vertices[2], .positions[2]
     )]
     Degenerate {
         count: usize,
+        /// Triangles checked (those of the kept component).
+        total: usize,
         triangle: usize,
         vertices: [u32; 3],
         positions: [Place; 3],
@@ -285,14 +328,18 @@ pub enum ImportError {
         position: Place,
     },
     #[error(
-        "the mesh is not closed: it has {}; the first runs through vertex {vertex} at {position} and has {} edges",
-        plural(*.loops, "hole (boundary loop)", "holes (boundary loops)"), .length
+        "the mesh is not closed: it has {}; the first runs through vertex {vertex} at {position} and has {} edges{}",
+        plural(*.loops, "hole (boundary loop)", "holes (boundary loops)"), .length,
+        list_holes(.others, *.loops)
     )]
     NotClosed {
         loops: usize,
         vertex: u32,
         position: Place,
         length: usize,
+        /// The next few loops (up to [`MORE_HOLES_NAMED`]): a vertex of each, its position, its
+        /// edges.
+        others: Vec<(u32, Place, usize)>,
     },
     #[error(
         "the mesh is not orientable (like a Möbius strip or a Klein bottle): its faces cannot agree on a side at the edge from vertex {} at {} to vertex {} at {}",
@@ -349,16 +396,19 @@ pub struct ValidMesh {
 
 /// Reads a mesh file, its format from its extension. File errors and format errors name the file.
 pub fn read_mesh(path: &Path) -> Result<ImportedMesh, ImportError> {
+    // What the path is comes first: a missing file, a directory or a FIFO is named as such, whatever
+    // its extension.
+    let meta = file_metadata(path)?;
     let format = MeshFormat::from_path(path)?;
-    let bytes = read_file(path)?;
+    let bytes = read_file(path, &meta)?;
     read_mesh_bytes(&bytes, format).map_err(|error| ImportError::InFile {
         path: path.to_owned(),
         error: Box::new(error),
     })
 }
 
-fn read_file(path: &Path) -> Result<Vec<u8>, ImportError> {
-    use std::io::Read;
+/// The file's metadata, refusing what is missing, not a regular file, or too large to read.
+fn file_metadata(path: &Path) -> Result<std::fs::Metadata, ImportError> {
     let meta = std::fs::metadata(path).map_err(|source| match source.kind() {
         std::io::ErrorKind::NotFound => ImportError::Missing {
             path: path.to_owned(),
@@ -381,6 +431,11 @@ fn read_file(path: &Path) -> Result<Vec<u8>, ImportError> {
             max: MAX_MESH_BYTES,
         });
     }
+    Ok(meta)
+}
+
+fn read_file(path: &Path, meta: &std::fs::Metadata) -> Result<Vec<u8>, ImportError> {
+    use std::io::Read;
     let unreadable = |source| ImportError::Unreadable {
         path: path.to_owned(),
         source,
@@ -425,6 +480,9 @@ fn file_kind(meta: &std::fs::Metadata) -> &'static str {
 
 /// Reads a mesh from a file's bytes (no file system: what the fuzz tests call).
 pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat) -> Result<ImportedMesh, ImportError> {
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(ImportError::Blank { bytes: bytes.len() });
+    }
     let raw = match format {
         MeshFormat::Obj => obj::read(bytes)?,
         MeshFormat::Ply => ply::read(bytes)?,
@@ -728,6 +786,7 @@ pub fn validate(mesh: ImportedMesh, keep_largest: bool) -> Result<ValidMesh, Imp
         let t = kept[first];
         return Err(ImportError::Degenerate {
             count: bad.len(),
+            total: kept.len(),
             triangle: original[first],
             vertices: t,
             positions: t.map(place),
@@ -782,6 +841,14 @@ pub fn validate(mesh: ImportedMesh, keep_largest: bool) -> Result<ValidMesh, Imp
             vertex: v,
             position: place(v),
             length: first.len(),
+            others: loops[1..]
+                .iter()
+                .take(MORE_HOLES_NAMED)
+                .map(|l| {
+                    let v = old(l.first().copied().unwrap_or(0));
+                    (v, place(v), l.len())
+                })
+                .collect(),
         });
     }
     let flips = mesh::validate::orient(&he).map_err(|(a, b)| {

@@ -88,13 +88,55 @@ fn parse_error(message: String) -> ImportError {
     }
 }
 
+/// ply-rs-bw's error as one line: its messages run over several (`Line 4: Couldn't parse line.`,
+/// then a tab-indented `String: '…'` with the line read and an `Error: …` with the grammar's
+/// debug output); this keeps the line number as the location, the first sentence, and the text
+/// that was read (quoted short), and drops the rest.
+fn library_error(e: &ply_rs_bw::parser::ParseError) -> ImportError {
+    let text = e.to_string();
+    let (line, rest) = match e.line() {
+        Some(n) => (
+            Location::Line(n),
+            text.strip_prefix(&format!("Line {n}: ")).unwrap_or(&text),
+        ),
+        None => (Location::Unknown, text.as_str()),
+    };
+    let first = rest
+        .lines()
+        .next()
+        .unwrap_or("")
+        .trim()
+        .trim_end_matches('.');
+    let mut message: String = first.chars().take(1).flat_map(char::to_lowercase).collect();
+    message.extend(first.chars().skip(1));
+    let read = rest
+        .split_once("\tString: ")
+        .map(|(_, r)| r.split("\n\tError").next().unwrap_or(""))
+        .map(|r| r.trim().trim_matches('\'').trim())
+        .filter(|r| !r.is_empty());
+    if let Some(read) = read {
+        message.push_str(&format!(": `{}`", super::obj::quote(read)));
+    }
+    // Whatever else the library says (kinds of error not seen yet) stays on one line.
+    let message = message.replace(|c: char| c.is_control(), " ");
+    ImportError::Parse {
+        format: FORMAT,
+        at: line,
+        message: if message.is_empty() {
+            "unreadable".into()
+        } else {
+            message
+        },
+    }
+}
+
 pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ImportError> {
     use ply_rs_bw::parser::Parser;
     let parser = Parser::<Record>::new();
     // The header first: counts no file could hold are refused before anything is read for them.
     let header = parser
         .read_ply_header(&mut std::io::Cursor::new(bytes))
-        .map_err(|e| parse_error(e.to_string()))?;
+        .map_err(|e| library_error(&e))?;
     let end = find(bytes, b"end_header").map_or(bytes.len(), |at| at + 10);
     let body = bytes.len() - end;
     let mut total = 0usize;
@@ -119,7 +161,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ImportError> {
     }
     let ply = parser
         .read_ply(&mut std::io::Cursor::new(bytes))
-        .map_err(|e| parse_error(e.to_string()))?;
+        .map_err(|e| library_error(&e))?;
     let mut raw = RawMesh::default();
     let vertices = ply.payload.get("vertex").map_or(&[][..], |v| &v[..]);
     if vertices.len() >= u32::MAX as usize {

@@ -1,8 +1,9 @@
 //! STL, binary or ASCII, read by hand. A file is binary when its size is exactly 84 + 50 × the
 //! triangle count in bytes 80..84 (some binary files begin with `solid` too); otherwise one that
-//! begins with `solid` is read as text, line by line (`facet normal`, `outer loop`, three or more
-//! `vertex x y z`, `endloop`, `endfacet`; several solids allowed; the normals are ignored). STL
-//! stores every triangle's corners apart, so exactly coincident corners are merged into one vertex.
+//! begins with `solid` and has no NUL byte in its first 84 bytes is read as text, line by line
+//! (`facet normal`, `outer loop`, three or more `vertex x y z`, `endloop`, `endfacet`; several
+//! solids allowed; the normals are ignored). STL stores every triangle's corners apart, so exactly
+//! coincident corners are merged into one vertex.
 
 use embedding::Point3;
 
@@ -18,8 +19,11 @@ pub(crate) fn read(bytes: &[u8]) -> Result<RawMesh, ImportError> {
             return binary(bytes, count);
         }
     }
+    // Many binary files begin with `solid` too; a NUL byte in the header or the count (which text
+    // never has) tells them apart when the size does not, as in a binary file cut short.
     let text = bytes.trim_ascii_start();
-    if text.len() >= 5 && text[..5].eq_ignore_ascii_case(b"solid") {
+    let binary_header = bytes.len() >= 84 && bytes[..84].contains(&0);
+    if text.len() >= 5 && text[..5].eq_ignore_ascii_case(b"solid") && !binary_header {
         return ascii(bytes);
     }
     if bytes.len() >= 84 {
