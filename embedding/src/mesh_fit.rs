@@ -1,7 +1,7 @@
 //! Fitting a user's mesh: any closed, oriented, manifold triangle mesh of genus 0 to 64 becomes a
 //! model, through the same relaxation, checks and least-squares fit as [`crate::fit`]'s plates.
 //!
-//! Genus 0 is mapped onto the sphere ([`crate::sphere_map`]: Floater's map of the mesh less one
+//! Genus 0 is mapped onto the sphere (`sphere_map.rs`: Floater's map of the mesh less one
 //! triangle, lifted to the sphere, relaxed there with Möbius centering). The rest of this module is
 //! about genus ≥ 1.
 //!

@@ -337,7 +337,7 @@ pub enum ImportError {
         vertex: u32,
         position: Place,
         length: usize,
-        /// The next few loops (up to [`MORE_HOLES_NAMED`]): a vertex of each, its position, its
+        /// The next few loops (up to `MORE_HOLES_NAMED`): a vertex of each, its position, its
         /// edges.
         others: Vec<(u32, Place, usize)>,
     },
