@@ -61,6 +61,8 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = std::time::Instant::now();
+    // A missing or unreadable input is the first thing to say, before anything about the output.
+    import::check_input(&args.mesh)?;
     let target = ntori::io::atomic::check_output(&args.output, &[&args.mesh])?;
     if !args.force && std::fs::symlink_metadata(&target).is_ok() {
         return Err(ntori::io::atomic::FileError::Exists { path: args.output }.into());

@@ -83,3 +83,22 @@ fn fit_maps_a_genus_zero_mesh_onto_the_sphere() {
     let layout = embedding::Layout::new(&atlas, model.settings).unwrap();
     model.validate(&layout).unwrap();
 }
+
+#[test]
+fn a_missing_mesh_is_named_before_the_output_is_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("model.json"), "kept").unwrap();
+    ntori()
+        .current_dir(dir.path())
+        .args(["fit", "missing.obj"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "cannot read missing.obj: no such file",
+        ))
+        .stderr(predicate::str::contains("exists").not());
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("model.json")).unwrap(),
+        "kept"
+    );
+}

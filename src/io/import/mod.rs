@@ -407,6 +407,14 @@ pub fn read_mesh(path: &Path) -> Result<ImportedMesh, ImportError> {
     })
 }
 
+/// Whether `path` could be a mesh to read: it exists, is a regular file within the size cap, and its
+/// extension names a format. Cheap, so a command can say so before it checks its output.
+pub fn check_input(path: &Path) -> Result<(), ImportError> {
+    file_metadata(path)?;
+    MeshFormat::from_path(path)?;
+    Ok(())
+}
+
 /// The file's metadata, refusing what is missing, not a regular file, or too large to read.
 fn file_metadata(path: &Path) -> Result<std::fs::Metadata, ImportError> {
     let meta = std::fs::metadata(path).map_err(|source| match source.kind() {
