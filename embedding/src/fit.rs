@@ -724,16 +724,7 @@ impl Lifts {
                 model[o as usize] += area2;
             }
         }
-        let ratio = surface.iter().sum::<f64>() / model.iter().sum::<f64>();
-        surface
-            .iter()
-            .zip(&model)
-            .map(|(s, m)| {
-                (s / (m * ratio).max(f64::MIN_POSITIVE))
-                    .sqrt()
-                    .clamp(0.1, 10.0)
-            })
-            .collect()
+        relative_stretch(&surface, &model)
     }
 
     /// Yoshizawa, Belyaev and Seidel's stretch-minimizing update, damped: each weight w_vu is divided
@@ -774,6 +765,21 @@ impl Lifts {
             })
             .count()
     }
+}
+
+/// Per vertex: √(3D area / model area) of its triangles (summed per vertex in `surface` and
+/// `model`), relative to the whole surface's ratio and clamped to [0.1, 10].
+pub(crate) fn relative_stretch(surface: &[f64], model: &[f64]) -> Vec<f64> {
+    let ratio = surface.iter().sum::<f64>() / model.iter().sum::<f64>();
+    surface
+        .iter()
+        .zip(model)
+        .map(|(s, m)| {
+            (s / (m * ratio).max(f64::MIN_POSITIVE))
+                .sqrt()
+                .clamp(0.1, 10.0)
+        })
+        .collect()
 }
 
 /// What a neighbour's weight is divided by where the map stretches the surface by `stretch` there

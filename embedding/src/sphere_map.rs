@@ -19,7 +19,7 @@
 use nalgebra::Vector3;
 
 use crate::EmbeddingError;
-use crate::fit::stretch_divisor;
+use crate::fit::{relative_stretch, stretch_divisor};
 use crate::floater;
 use crate::surface::Point3;
 
@@ -261,16 +261,7 @@ fn stretch(points: &[Vector3<f64>], positions: &[Point3], triangles: &[[u32; 3]]
             sphere[v as usize] += excess.max(0.0);
         }
     }
-    let ratio = surface.iter().sum::<f64>() / sphere.iter().sum::<f64>();
-    surface
-        .iter()
-        .zip(&sphere)
-        .map(|(s, m)| {
-            (s / (m * ratio).max(f64::MIN_POSITIVE))
-                .sqrt()
-                .clamp(0.1, 10.0)
-        })
-        .collect()
+    relative_stretch(&surface, &sphere)
 }
 
 #[cfg(test)]

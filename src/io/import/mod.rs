@@ -429,7 +429,7 @@ fn file_metadata(path: &Path) -> Result<std::fs::Metadata, ImportError> {
     if !meta.is_file() {
         return Err(ImportError::NotRegular {
             path: path.to_owned(),
-            kind: file_kind(&meta),
+            kind: crate::io::atomic::kind_of(&meta.file_type()),
         });
     }
     if meta.len() > MAX_MESH_BYTES {
@@ -462,28 +462,6 @@ fn read_file(path: &Path, meta: &std::fs::Metadata) -> Result<Vec<u8>, ImportErr
         });
     }
     Ok(bytes)
-}
-
-fn file_kind(meta: &std::fs::Metadata) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        let t = meta.file_type();
-        if t.is_fifo() {
-            return "FIFO";
-        }
-        if t.is_block_device() || t.is_char_device() {
-            return "device";
-        }
-        if t.is_socket() {
-            return "socket";
-        }
-    }
-    if meta.is_dir() {
-        "directory"
-    } else {
-        "special file"
-    }
 }
 
 /// Reads a mesh from a file's bytes (no file system: what the fuzz tests call).
