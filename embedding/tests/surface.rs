@@ -627,3 +627,76 @@ fn surfaces_are_validated_once_when_built() {
     other.genus = 3;
     assert!(embedding::Surface::from_model(&other).is_err());
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// The tensor stencil (f32 factors, sums about the centre, negligible blends left out) gives the
+    /// f64 stencil's positions to 1e-6 of the bounding-box diagonal, for any genus, degree, grid and
+    /// blend continuity, and wherever the model sits; all cores give the very same numbers.
+    #[test]
+    fn tensor_stencil_positions_match_the_f64_stencil(
+        genus in prop::sample::select(vec![0u32, 1, 2, 3, 5, 8, 16]),
+        degree in 2usize..=5,
+        grid in 8usize..=20,
+        continuity in 1usize..=3,
+        seed in any::<u64>(),
+        offset in prop::array::uniform3(-1e4f64..1e4),
+        units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..400),
+    ) {
+        let atlas = atlas(genus);
+        let settings = SplineSettings { degree, grid, continuity };
+        let layout = Layout::new(atlas, settings).unwrap();
+        let shift = Vector3::from(offset);
+        let control: Vec<Point3> = noisy_controls(&layout, seed).into_iter().map(|c| c + shift).collect();
+        let mut points: Vec<ChartPoint> = units.iter().map(|&(a, b, c)| chart_point(atlas, a, b, c)).collect();
+        // And a whole coarse tessellation: chart boundaries, corners, the vertex chart's centre.
+        points.extend(atlas.tessellate(3, 2).unwrap().vertices);
+        let exact_stencil = Stencil::build(&layout, &points);
+        let tensor = embedding::TensorStencil::build(&layout, &points);
+        prop_assert_eq!(tensor.rows(), points.len());
+        let mut exact = vec![Point3::origin(); points.len()];
+        exact_stencil.positions(&control, &mut exact);
+        let mut fast = vec![Point3::origin(); points.len()];
+        tensor.positions(&control, &mut fast);
+        let (lo, hi) = embedding::bounding_box(&exact);
+        let diagonal = (hi - lo).norm();
+        let worst = fast.iter().zip(&exact).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        prop_assert!(worst <= 1e-6 * diagonal, "off by {:e} of the diagonal", worst / diagonal);
+        let mut parallel = vec![Point3::origin(); points.len()];
+        tensor.positions_parallel(&control, &mut parallel);
+        prop_assert_eq!(parallel, fast);
+        // Far fewer bytes than the full stencil's (p+1)² weights per chart.
+        let full_bytes = 12.0 * exact_stencil.nonzeros() as f64 / points.len() as f64 + 8.0 + 24.0;
+        prop_assert!(tensor.bytes_per_row() < 0.6 * full_bytes);
+    }
+}
+
+/// Over many parallel tasks (a tessellation of 10⁴ vertices), all cores give the one-thread numbers.
+#[test]
+fn tensor_stencil_gives_the_same_numbers_on_all_cores() {
+    let atlas = atlas(2);
+    let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
+    let control = noisy_controls(&layout, 11);
+    let points = atlas.tessellate(24, 24).unwrap().vertices;
+    assert!(points.len() > 10_000);
+    let tensor = embedding::TensorStencil::build(&layout, &points);
+    let mut one = vec![Point3::origin(); points.len()];
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| tensor.positions(&control, &mut one));
+    let mut all = vec![Point3::origin(); points.len()];
+    tensor.positions_parallel(&control, &mut all);
+    assert_eq!(one, all);
+    // The stencil built on one thread is the same stencil.
+    let again = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| embedding::TensorStencil::build(&layout, &points));
+    let mut from_again = vec![Point3::origin(); points.len()];
+    again.positions(&control, &mut from_again);
+    assert_eq!(one, from_again);
+}

@@ -7,15 +7,16 @@ use std::time::Instant;
 
 use charts::{Atlas, ChartPoint};
 use embedding::edit::{Constraint, RefreshScratch, refresh, solve};
-use embedding::{Layout, Point3, SplineSettings, Stencil, Vector3};
+use embedding::{Layout, Point3, SplineSettings, Stencil, TensorStencil, Vector3};
 use serde::Serialize;
 
 use super::{GenusArg, spinner, write_stdout};
 
 /// Measure throughput and print it as JSON.
 ///
-/// Figures for tessellation, point location, stencil building, re-embedding (also as a fraction
-/// of memory copy bandwidth) and drag events. Baselines (copy bandwidth, a chain of scalar
+/// Figures for tessellation, point location, stencil building (the tensor stencil on all cores, and
+/// the full f64 stencil with derivatives), re-embedding (the tensor stencil on one thread and on all
+/// cores, and the full stencil; each also as a fraction of memory copy bandwidth) and drag events. Baselines (copy bandwidth, a chain of scalar
 /// multiply-adds) are measured in the same run, and every figure is also given per baseline
 /// operation, since this machine is shared and noisy.
 ///
@@ -164,14 +165,39 @@ pub fn measure(
         })
         .collect();
     progress("stencil build");
+    let mut tensor = TensorStencil::default();
+    let secs = best_of(2, || tensor = TensorStencil::build(&layout, &pts));
+    add("stencil_build", pts.len() as f64 / secs, "vertices", None);
     let mut stencil = Stencil::default();
     let secs = best_of(2, || stencil = Stencil::build(&layout, &pts));
-    add("stencil_build", pts.len() as f64 / secs, "vertices", None);
+    add(
+        "stencil_build_full",
+        pts.len() as f64 / secs,
+        "vertices",
+        None,
+    );
     progress("re-embedding");
     let mut out = vec![Point3::origin(); stencil.rows()];
+    let bytes = Some(tensor.bytes_per_row());
+    let secs = best_of(5, || tensor.positions(black_box(&control), &mut out));
+    add("reembed", pts.len() as f64 / secs, "vertices", bytes);
+    let secs = best_of(5, || {
+        tensor.positions_parallel(black_box(&control), &mut out)
+    });
+    add(
+        "reembed_all_cores",
+        pts.len() as f64 / secs,
+        "vertices",
+        bytes,
+    );
     let secs = best_of(5, || stencil.positions(black_box(&control), &mut out));
-    let bytes = 8.0 + 12.0 * stencil.nonzeros() as f64 / stencil.rows() as f64 + 24.0;
-    add("reembed", pts.len() as f64 / secs, "vertices", Some(bytes));
+    let full_bytes = 8.0 + 12.0 * stencil.nonzeros() as f64 / stencil.rows() as f64 + 24.0;
+    add(
+        "reembed_full_f64",
+        pts.len() as f64 / secs,
+        "vertices",
+        Some(full_bytes),
+    );
     progress("drag events");
     let index = stencil.column_index(layout.control_count());
     let mut scratch = RefreshScratch::default();

@@ -10,6 +10,7 @@ pub mod camera;
 pub mod gpu;
 mod legend;
 pub mod palette;
+pub mod reembed;
 pub mod scene;
 
 use embedding::Surface;

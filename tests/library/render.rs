@@ -205,3 +205,50 @@ fn impossible_requests_are_errors() {
             .is_err()
     );
 }
+
+/// The GPU's re-embedding (a compute shader over the tensor stencil) equals the CPU's f64 stencil to
+/// 1e-6 of the bounding-box diagonal, on the example models of genus 0–3 moved far from the origin,
+/// at tessellations of many 64-row workgroups (the last one partly full).
+#[test]
+fn gpu_reembedding_equals_the_cpu_to_a_millionth_of_the_diagonal() {
+    use embedding::{Point3, Stencil, TensorStencil, Vector3};
+    let (device, queue, _) = ntori::render::open_device(None).expect("a graphics adapter");
+    for genus in 0..=3 {
+        let model = crate::common::small_model(genus);
+        let shift = Vector3::new(250.0, -1e3, 40.0);
+        let control: Vec<Point3> = model.control_points().iter().map(|c| c + shift).collect();
+        let layout = model.layout();
+        let points = model.atlas().tessellate(9, 7).unwrap().vertices;
+        let exact_stencil = Stencil::build(&layout, &points);
+        let mut exact = vec![Point3::origin(); points.len()];
+        exact_stencil.positions(&control, &mut exact);
+        let gpu = ntori::render::reembed::GpuReembed::new(
+            &device,
+            &TensorStencil::build(&layout, &points),
+            control.len(),
+        )
+        .unwrap();
+        assert_eq!(gpu.rows(), points.len());
+        let mut out = vec![Point3::origin(); points.len()];
+        gpu.positions(&device, &queue, &control, &mut out).unwrap();
+        let (lo, hi) = embedding::bounding_box(&exact);
+        let diagonal = (hi - lo).norm();
+        let worst = out
+            .iter()
+            .zip(&exact)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        assert!(
+            worst <= 1e-6 * diagonal,
+            "genus {genus}: off by {:e} of the diagonal",
+            worst / diagonal
+        );
+        // A second upload of other control points replaces the first.
+        let moved: Vec<Point3> = control
+            .iter()
+            .map(|c| c + Vector3::new(1.0, 2.0, 3.0))
+            .collect();
+        gpu.positions(&device, &queue, &moved, &mut out).unwrap();
+        assert!((out[0] - (exact[0] + Vector3::new(1.0, 2.0, 3.0))).norm() <= 1e-6 * diagonal);
+    }
+}

@@ -1,9 +1,17 @@
 //! Stencils: for a fixed set of surface points (a tessellation's vertices), the sparse weights with
 //! positions = W · control points, and the same for the first derivatives that normals need.
 //!
+//! [`Stencil`] holds every weight, with its derivatives, in f64: the editor's column updates and
+//! normals use it. [`TensorStencil`] holds positions only, factored chart by chart, in far fewer
+//! bytes: full re-embedding streams it.
+//!
 //! Stored as compressed rows with the weights in separate arrays (structure of arrays), because the
 //! re-embedding loop streams them: a position touches 4 + 8 bytes per weight. A column index (which
 //! rows each control point touches) makes a change to a few control points a sparse update.
+
+mod tensor;
+
+pub use tensor::{ControlFrame, NEGLIGIBLE_BLEND, TensorStencil};
 
 use charts::ChartPoint;
 

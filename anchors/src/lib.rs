@@ -1,0 +1,357 @@
+//! The tools ntori is measured against, behind safe Rust types: today OpenSubdiv's Far stencils
+//! (Catmull–Clark uniform refinement stencils and limit stencils) and its CPU evaluator, through a
+//! small C++ shim over the system library (Debian's `libosd-dev`, OpenSubdiv 3.5).
+//!
+//! Benches and comparison tests use it; nothing in ntori's own pipeline does. Without the library
+//! the crate still builds and [`available`] is false: every constructor then returns
+//! [`Error::Unavailable`], so a machine without OpenSubdiv can build and test everything else.
+//!
+//! Bench inputs: [`QuadMesh::genus_cage`] makes a closed all-quad cage of any genus.
+
+mod cage;
+mod sys;
+
+use std::ffi::c_void;
+
+pub use cage::QuadMesh;
+
+/// What went wrong in a call to OpenSubdiv.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum Error {
+    #[error("OpenSubdiv is not available in this build (apt-get install libosd-dev, then rebuild)")]
+    Unavailable,
+    #[error("OpenSubdiv failed to {0}")]
+    Failed(&'static str),
+    #[error("the mesh is too large for OpenSubdiv's 32-bit indices")]
+    TooLarge,
+}
+
+/// Whether this build links OpenSubdiv.
+pub fn available() -> bool {
+    cfg!(not(osd_missing))
+}
+
+fn int(n: usize) -> Result<i32, Error> {
+    i32::try_from(n).map_err(|_| Error::TooLarge)
+}
+
+/// A Catmull–Clark topology refiner over a closed quad mesh.
+pub struct Refiner {
+    raw: *mut c_void,
+    /// Vertices of the base mesh (what stencils are applied to).
+    base_vertices: usize,
+}
+
+impl Refiner {
+    /// A refiner for `mesh`'s topology (its positions are not needed until stencils are applied).
+    pub fn new(mesh: &QuadMesh) -> Result<Refiner, Error> {
+        if !available() {
+            return Err(Error::Unavailable);
+        }
+        let counts = vec![4i32; mesh.faces.len()];
+        let indices = mesh
+            .faces
+            .iter()
+            .flatten()
+            .map(|&v| int(v as usize))
+            .collect::<Result<Vec<i32>, Error>>()?;
+        let (v, f) = (int(mesh.positions.len())?, int(mesh.faces.len())?);
+        // SAFETY: counts holds f entries summing to indices.len(); the shim copies what it keeps.
+        let raw = unsafe { sys::ntori_osd_refiner_new(v, f, counts.as_ptr(), indices.as_ptr()) };
+        if raw.is_null() {
+            return Err(Error::Failed("build the topology refiner"));
+        }
+        Ok(Refiner {
+            raw,
+            base_vertices: mesh.positions.len(),
+        })
+    }
+
+    /// Uniform refinement to `level`, then the stencils of that level's vertices.
+    pub fn uniform_stencils(mesh: &QuadMesh, level: u32) -> Result<StencilTable, Error> {
+        let refiner = Refiner::new(mesh)?;
+        refiner.refine_uniform(level)?;
+        refiner.stencils()
+    }
+
+    /// Refines uniformly to `level`; returns that level's vertex count.
+    pub fn refine_uniform(&self, level: u32) -> Result<usize, Error> {
+        // SAFETY: raw is a live refiner.
+        let n = unsafe { sys::ntori_osd_refine_uniform(self.raw, level.min(10) as i32) };
+        if n <= 0 {
+            return Err(Error::Failed("refine uniformly"));
+        }
+        Ok(n as usize)
+    }
+
+    /// Refines adaptively (isolating extraordinary vertices) to `level`, as limit stencils need.
+    pub fn refine_adaptive(&self, level: u32) -> Result<(), Error> {
+        // SAFETY: raw is a live refiner.
+        match unsafe { sys::ntori_osd_refine_adaptive(self.raw, level.min(10) as i32) } {
+            1 => Ok(()),
+            _ => Err(Error::Failed("refine adaptively")),
+        }
+    }
+
+    /// The uniform stencils of the finest level (after [`Refiner::refine_uniform`]).
+    pub fn stencils(&self) -> Result<StencilTable, Error> {
+        // SAFETY: raw is a live, refined refiner.
+        let raw = unsafe { sys::ntori_osd_uniform_stencils(self.raw) };
+        StencilTable::wrap(raw, self.base_vertices, false, "make uniform stencils")
+    }
+
+    /// Limit stencils at `(face, s, t)` locations (after [`Refiner::refine_adaptive`]); locations of
+    /// one face must be consecutive. With `derivatives`, the tables also carry ∂/∂s and ∂/∂t.
+    pub fn limit_stencils(
+        &self,
+        locations: &[(u32, f32, f32)],
+        derivatives: bool,
+    ) -> Result<StencilTable, Error> {
+        let faces = locations
+            .iter()
+            .map(|l| int(l.0 as usize))
+            .collect::<Result<Vec<i32>, Error>>()?;
+        let s: Vec<f32> = locations.iter().map(|l| l.1).collect();
+        let t: Vec<f32> = locations.iter().map(|l| l.2).collect();
+        // SAFETY: the three arrays hold locations.len() entries; the shim reads them during the call.
+        let raw = unsafe {
+            sys::ntori_osd_limit_stencils(
+                self.raw,
+                int(locations.len())?,
+                faces.as_ptr(),
+                s.as_ptr(),
+                t.as_ptr(),
+                i32::from(derivatives),
+            )
+        };
+        StencilTable::wrap(raw, self.base_vertices, derivatives, "make limit stencils")
+    }
+}
+
+impl Drop for Refiner {
+    fn drop(&mut self) {
+        // SAFETY: raw came from ntori_osd_refiner_new and is freed once.
+        unsafe { sys::ntori_osd_refiner_free(self.raw) }
+    }
+}
+
+/// A table of stencils (rows of weights on the base mesh's vertices), uniform or limit.
+pub struct StencilTable {
+    raw: *mut c_void,
+    base_vertices: usize,
+    rows: usize,
+    derivatives: bool,
+}
+
+impl StencilTable {
+    fn wrap(
+        raw: *mut c_void,
+        base_vertices: usize,
+        derivatives: bool,
+        what: &'static str,
+    ) -> Result<StencilTable, Error> {
+        if raw.is_null() {
+            return Err(Error::Failed(what));
+        }
+        // SAFETY: raw is a live table.
+        let rows = unsafe { sys::ntori_osd_stencil_count(raw) }.max(0) as usize;
+        Ok(StencilTable {
+            raw,
+            base_vertices,
+            rows,
+            derivatives,
+        })
+    }
+
+    /// Number of stencils (output points).
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Number of stored weights (for the position; derivatives have as many again each).
+    pub fn weights(&self) -> usize {
+        // SAFETY: raw is a live table.
+        unsafe { sys::ntori_osd_weight_count(self.raw) }.max(0) as usize
+    }
+
+    /// Bytes the position evaluation streams per output point: an i32 index and an f32 weight per
+    /// weight, a size and an offset per row, and the written float3.
+    pub fn bytes_per_row(&self) -> f64 {
+        8.0 * self.weights() as f64 / self.rows.max(1) as f64 + 8.0 + 12.0
+    }
+
+    fn check(&self, src: &[[f32; 3]], outputs: &[&[[f32; 3]]]) {
+        assert_eq!(
+            src.len(),
+            self.base_vertices,
+            "one source point per base vertex"
+        );
+        for out in outputs {
+            assert_eq!(out.len(), self.rows, "one output point per stencil");
+        }
+    }
+
+    /// `dst[i]` = stencil i applied to `src` (OpenSubdiv's single-threaded CPU evaluator).
+    pub fn apply(&self, src: &[[f32; 3]], dst: &mut [[f32; 3]]) -> Result<(), Error> {
+        self.check(src, &[&*dst]);
+        // SAFETY: src holds the base vertices, dst one float3 per stencil (checked above).
+        let ok = unsafe {
+            sys::ntori_osd_apply(
+                self.raw,
+                src.as_ptr().cast(),
+                dst.as_mut_ptr().cast(),
+                0,
+                self.rows as i32,
+            )
+        };
+        if ok == 1 {
+            Ok(())
+        } else {
+            Err(Error::Failed("apply stencils"))
+        }
+    }
+
+    /// [`StencilTable::apply`] with the first derivatives, for limit stencils made with them.
+    pub fn apply_with_derivatives(
+        &self,
+        src: &[[f32; 3]],
+        dst: &mut [[f32; 3]],
+        du: &mut [[f32; 3]],
+        dv: &mut [[f32; 3]],
+    ) -> Result<(), Error> {
+        if !self.derivatives {
+            return Err(Error::Failed(
+                "apply derivatives of a table made without them",
+            ));
+        }
+        self.check(src, &[&*dst, &*du, &*dv]);
+        // SAFETY: as in apply; du and dv hold one float3 per stencil too.
+        let ok = unsafe {
+            sys::ntori_osd_apply_with_derivatives(
+                self.raw,
+                src.as_ptr().cast(),
+                dst.as_mut_ptr().cast(),
+                du.as_mut_ptr().cast(),
+                dv.as_mut_ptr().cast(),
+                0,
+                self.rows as i32,
+            )
+        };
+        if ok == 1 {
+            Ok(())
+        } else {
+            Err(Error::Failed("apply limit stencils with derivatives"))
+        }
+    }
+}
+
+impl Drop for StencilTable {
+    fn drop(&mut self) {
+        // SAFETY: raw came from the shim and is freed once.
+        unsafe { sys::ntori_osd_stencils_free(self.raw) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tests below run only where OpenSubdiv is linked; CI links it (and says so here).
+    fn linked() -> bool {
+        if !available() && std::env::var_os("NTORI_REQUIRE_TOOLS").is_some() {
+            panic!("NTORI_REQUIRE_TOOLS is set but OpenSubdiv is not linked");
+        }
+        available()
+    }
+
+    #[test]
+    fn uniform_stencils_have_a_row_per_refined_vertex_and_reproduce_affine_maps() {
+        if !linked() {
+            return;
+        }
+        for genus in 0..=3 {
+            let cage = QuadMesh::genus_cage(genus);
+            for level in 1..=4 {
+                let table = Refiner::uniform_stencils(&cage, level).unwrap();
+                assert_eq!(table.rows(), cage.refined_vertex_count(level));
+                // Catmull–Clark reproduces affine functions of the control points: a translated
+                // and scaled cage refines to the same points translated and scaled.
+                let moved: Vec<[f32; 3]> = cage
+                    .positions
+                    .iter()
+                    .map(|p| [2.0 * p[0] + 1.0, 2.0 * p[1], 2.0 * p[2] - 3.0])
+                    .collect();
+                let mut a = vec![[0.0; 3]; table.rows()];
+                let mut b = a.clone();
+                table.apply(&cage.positions, &mut a).unwrap();
+                table.apply(&moved, &mut b).unwrap();
+                for (p, q) in a.iter().zip(&b) {
+                    let want = [2.0 * p[0] + 1.0, 2.0 * p[1], 2.0 * p[2] - 3.0];
+                    for d in 0..3 {
+                        assert!((want[d] - q[d]).abs() < 1e-4, "genus {genus} level {level}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The limit stencils' derivative rows agree with central differences of their position rows.
+    #[test]
+    fn limit_derivatives_match_differences_of_positions() {
+        if !linked() {
+            return;
+        }
+        let cage = QuadMesh::genus_cage(2);
+        let refiner = Refiner::new(&cage).unwrap();
+        refiner.refine_adaptive(4).unwrap();
+        let h = 1e-3f32;
+        let mut locations = Vec::new();
+        for (f, s, t) in cage.limit_locations(3) {
+            locations.extend([
+                (f, s, t),
+                (f, s + h, t),
+                (f, s - h, t),
+                (f, s, t + h),
+                (f, s, t - h),
+            ]);
+        }
+        let table = refiner.limit_stencils(&locations, true).unwrap();
+        let n = table.rows();
+        assert_eq!(n, locations.len());
+        let (mut p, mut du, mut dv) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        table
+            .apply_with_derivatives(&cage.positions, &mut p, &mut du, &mut dv)
+            .unwrap();
+        for k in (0..n).step_by(5) {
+            for d in 0..3 {
+                let fd_s = (p[k + 1][d] - p[k + 2][d]) / (2.0 * h);
+                let fd_t = (p[k + 3][d] - p[k + 4][d]) / (2.0 * h);
+                assert!(
+                    (fd_s - du[k][d]).abs() < 2e-2,
+                    "row {k}: {fd_s} vs {}",
+                    du[k][d]
+                );
+                assert!(
+                    (fd_t - dv[k][d]).abs() < 2e-2,
+                    "row {k}: {fd_t} vs {}",
+                    dv[k][d]
+                );
+            }
+        }
+        // Inside the cage's box, and not all at one point.
+        assert!(
+            p.iter()
+                .all(|q| q.iter().all(|c| (-0.01..=5.01).contains(c)))
+        );
+        assert!(p.iter().any(|q| (q[0] - p[0][0]).abs() > 0.5));
+    }
+
+    #[test]
+    fn unavailable_is_said_not_panicked() {
+        if available() {
+            return;
+        }
+        let cage = QuadMesh::genus_cage(2);
+        assert_eq!(Refiner::new(&cage).err(), Some(Error::Unavailable));
+    }
+}

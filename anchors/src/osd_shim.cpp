@@ -1,0 +1,164 @@
+// A C interface to the parts of OpenSubdiv 3.5 that ntori is measured against: a Catmull-Clark
+// topology refiner, its uniform refinement stencils, its limit stencils at given (face, s, t)
+// locations, and the CPU evaluator that applies them. Each phase is its own call so that the Rust
+// side can time the factories apart from refinement. Every entry point catches C++ exceptions and
+// reports failure as a null pointer or a zero return; none of them throws into Rust.
+
+#include <opensubdiv/far/stencilTable.h>
+#include <opensubdiv/far/stencilTableFactory.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/far/topologyRefinerFactory.h>
+#include <opensubdiv/osd/bufferDescriptor.h>
+#include <opensubdiv/osd/cpuEvaluator.h>
+
+#include <vector>
+
+using namespace OpenSubdiv;
+
+namespace {
+
+struct Table {
+    Far::StencilTableReal<float> const *stencils;
+    Far::LimitStencilTable const *limit;  // the same object when these are limit stencils
+};
+
+}  // namespace
+
+extern "C" {
+
+// A Catmull-Clark refiner over a closed polygon mesh (`counts[f]` corners for face f, their vertex
+// indices in `indices`, faces in order).
+void *ntori_osd_refiner_new(int vertices, int faces, const int *counts, const int *indices) {
+    try {
+        typedef Far::TopologyDescriptor Descriptor;
+        Sdc::Options options;
+        options.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+        Descriptor desc;
+        desc.numVertices = vertices;
+        desc.numFaces = faces;
+        desc.numVertsPerFace = counts;
+        desc.vertIndicesPerFace = indices;
+        Far::TopologyRefinerFactory<Descriptor>::Options create(Sdc::SCHEME_CATMARK, options);
+        return Far::TopologyRefinerFactory<Descriptor>::Create(desc, create);
+    } catch (...) {
+        return nullptr;
+    }
+}
+
+void ntori_osd_refiner_free(void *refiner) {
+    delete static_cast<Far::TopologyRefiner *>(refiner);
+}
+
+// Uniform refinement to `level`; returns the number of vertices at that level, 0 on failure.
+int ntori_osd_refine_uniform(void *refiner, int level) {
+    try {
+        Far::TopologyRefiner *r = static_cast<Far::TopologyRefiner *>(refiner);
+        Far::TopologyRefiner::UniformOptions options(level);
+        options.fullTopologyInLastLevel = false;
+        r->RefineUniform(options);
+        return r->GetLevel(level).GetNumVertices();
+    } catch (...) {
+        return 0;
+    }
+}
+
+// Adaptive refinement (feature isolation) to `level`, as limit stencils need; 1 on success.
+int ntori_osd_refine_adaptive(void *refiner, int level) {
+    try {
+        Far::TopologyRefiner *r = static_cast<Far::TopologyRefiner *>(refiner);
+        r->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(level));
+        return 1;
+    } catch (...) {
+        return 0;
+    }
+}
+
+// The stencils of the finest uniform level's vertices, in terms of the base mesh's vertices.
+void *ntori_osd_uniform_stencils(const void *refiner) {
+    try {
+        Far::TopologyRefiner const *r = static_cast<Far::TopologyRefiner const *>(refiner);
+        Far::StencilTableFactory::Options options;
+        options.generateIntermediateLevels = false;
+        options.generateOffsets = true;
+        Table *t = new Table;
+        t->stencils = Far::StencilTableFactory::Create(*r, options);
+        t->limit = nullptr;
+        return t;
+    } catch (...) {
+        return nullptr;
+    }
+}
+
+// Limit stencils (with first derivatives when `derivatives` is non-zero) at `count` locations:
+// ptex face `faces[k]`, parameters (s[k], t[k]). Locations of one face must be consecutive.
+void *ntori_osd_limit_stencils(const void *refiner, int count, const int *faces, const float *s,
+                               const float *t, int derivatives) {
+    try {
+        Far::TopologyRefiner const *r = static_cast<Far::TopologyRefiner const *>(refiner);
+        Far::LimitStencilTableFactory::LocationArrayVec locations;
+        for (int k = 0; k < count;) {
+            int end = k;
+            while (end < count && faces[end] == faces[k]) ++end;
+            Far::LimitStencilTableFactory::LocationArray run;
+            run.ptexIdx = faces[k];
+            run.numLocations = end - k;
+            run.s = s + k;
+            run.t = t + k;
+            locations.push_back(run);
+            k = end;
+        }
+        Far::LimitStencilTableFactory::Options options;
+        options.generate1stDerivatives = derivatives != 0;
+        Far::LimitStencilTable const *limit =
+            Far::LimitStencilTableFactory::Create(*r, locations, nullptr, nullptr, options);
+        if (!limit) return nullptr;
+        Table *table = new Table;
+        table->stencils = limit;
+        table->limit = limit;
+        return table;
+    } catch (...) {
+        return nullptr;
+    }
+}
+
+void ntori_osd_stencils_free(void *table) {
+    Table *t = static_cast<Table *>(table);
+    if (t) delete t->stencils;
+    delete t;
+}
+
+int ntori_osd_stencil_count(const void *table) {
+    return static_cast<Table const *>(table)->stencils->GetNumStencils();
+}
+
+long ntori_osd_weight_count(const void *table) {
+    return static_cast<long>(static_cast<Table const *>(table)->stencils->GetWeights().size());
+}
+
+// dst[3 i ..] = stencil i applied to the float3 points `src`, for i in [start, end); 1 on success.
+int ntori_osd_apply(const void *table, const float *src, float *dst, int start, int end) {
+    Far::StencilTableReal<float> const *st = static_cast<Table const *>(table)->stencils;
+    Osd::BufferDescriptor desc(0, 3, 3);
+    return Osd::CpuEvaluator::EvalStencils(src, desc, dst, desc, &st->GetSizes()[0],
+                                           &st->GetOffsets()[0], &st->GetControlIndices()[0],
+                                           &st->GetWeights()[0], start, end)
+               ? 1
+               : 0;
+}
+
+// As ntori_osd_apply, with the first derivatives into du and dv (limit stencils made with them).
+int ntori_osd_apply_with_derivatives(const void *table, const float *src, float *dst, float *du,
+                                     float *dv, int start, int end) {
+    Far::LimitStencilTable const *st = static_cast<Table const *>(table)->limit;
+    if (!st || st->GetDuWeights().empty()) return 0;
+    Osd::BufferDescriptor desc(0, 3, 3);
+    return Osd::CpuEvaluator::EvalStencils(src, desc, dst, desc, du, desc, dv, desc,
+                                           &st->GetSizes()[0], &st->GetOffsets()[0],
+                                           &st->GetControlIndices()[0], &st->GetWeights()[0],
+                                           &st->GetDuWeights()[0], &st->GetDvWeights()[0], start,
+                                           end)
+               ? 1
+               : 0;
+}
+
+}  // extern "C"

@@ -1,0 +1,228 @@
+//! Re-embedding on the GPU: [`embedding::TensorStencil`]'s rows applied by a compute shader
+//! (`shaders/reembed.wgsl`), the same sums as the CPU's kernel, in f32 about the control points'
+//! centre. Tested against the CPU on lavapipe (`tests/library/render.rs`).
+
+use embedding::{ControlFrame, Point3, TensorStencil, Vector3};
+use wgpu::util::DeviceExt;
+
+use super::gpu::{buffer_entry, pipeline_layout};
+use super::{RenderError, check_buffer};
+
+/// Rows per workgroup (the shader's `@workgroup_size`).
+const GROUP: u32 = 64;
+/// The most workgroups in one dimension of a dispatch (WebGPU's limit).
+const MAX_GROUPS: u32 = 65_535;
+
+/// A tensor stencil uploaded to a device, with buffers for the control points and the positions.
+pub struct GpuReembed {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    control: wgpu::Buffer,
+    positions: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    rows: u32,
+    control_count: usize,
+}
+
+impl GpuReembed {
+    /// Uploads `stencil` (for `control_count` control points) to `device`.
+    pub fn new(
+        device: &wgpu::Device,
+        stencil: &TensorStencil,
+        control_count: usize,
+    ) -> Result<GpuReembed, RenderError> {
+        let limits = device.limits();
+        let rows = u32::try_from(stencil.rows()).map_err(|_| too_many(stencil.rows()))?;
+        let blocks = pack_blocks(stencil);
+        let position_bytes = 16 * u64::from(rows.max(1));
+        check_buffer(
+            &limits,
+            "re-embedding stencil",
+            4 * blocks.len() as u64,
+            true,
+        )?;
+        check_buffer(&limits, "re-embedded positions", position_bytes, true)?;
+        check_buffer(&limits, "control points", 16 * control_count as u64, true)?;
+        let storage = |label, contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let params = [
+            rows,
+            stencil.order() as u32,
+            stencil.grid() as u32,
+            1 + 2 * stencil.order() as u32,
+        ];
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("ntori reembed params"),
+            contents: bytemuck::cast_slice(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let starts = storage(
+            "ntori reembed rows",
+            bytemuck::cast_slice(padded(stencil.row_starts())),
+        );
+        // An empty binding is not allowed: one word stands in for no blocks.
+        let blocks = storage(
+            "ntori reembed blocks",
+            bytemuck::cast_slice(padded(&blocks)),
+        );
+        let buffer = |label, size: u64, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        use wgpu::BufferUsages as U;
+        let control = buffer(
+            "ntori reembed control",
+            16 * control_count.max(1) as u64,
+            U::STORAGE | U::COPY_DST,
+        );
+        let positions = buffer(
+            "ntori reembed positions",
+            position_bytes,
+            U::STORAGE | U::COPY_SRC,
+        );
+        let readback = buffer(
+            "ntori reembed readback",
+            position_bytes,
+            U::MAP_READ | U::COPY_DST,
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("reembed.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/reembed.wgsl").into()),
+        });
+        use wgpu::BufferBindingType as B;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ntori reembed"),
+            entries: &[
+                buffer_entry(0, compute, B::Uniform),
+                buffer_entry(1, compute, B::Storage { read_only: true }),
+                buffer_entry(2, compute, B::Storage { read_only: true }),
+                buffer_entry(3, compute, B::Storage { read_only: true }),
+                buffer_entry(4, compute, B::Storage { read_only: false }),
+            ],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("ntori reembed"),
+            layout: &layout,
+            entries: &[&params, &starts, &blocks, &control, &positions]
+                .iter()
+                .enumerate()
+                .map(|(k, b)| wgpu::BindGroupEntry {
+                    binding: k as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect::<Vec<_>>(),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("ntori reembed"),
+            layout: Some(&pipeline_layout(device, "ntori reembed", &[&layout])),
+            module: &module,
+            entry_point: Some("reembed"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Ok(GpuReembed {
+            pipeline,
+            bind_group,
+            control,
+            positions,
+            readback,
+            rows,
+            control_count,
+        })
+    }
+
+    pub fn rows(&self) -> usize {
+        self.rows as usize
+    }
+
+    /// Uploads `control`, applies the stencil on the device and reads the positions back into `out`.
+    pub fn positions(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        control: &[Point3],
+        out: &mut [Point3],
+    ) -> Result<(), RenderError> {
+        assert_eq!(
+            control.len(),
+            self.control_count,
+            "the stencil's control points"
+        );
+        let frame = ControlFrame::new(control);
+        queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&frame.points));
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            let groups = self.rows.div_ceil(GROUP);
+            pass.dispatch_workgroups(groups.min(MAX_GROUPS), groups.div_ceil(MAX_GROUPS), 1);
+        }
+        let bytes = 16 * u64::from(self.rows);
+        if bytes > 0 {
+            encoder.copy_buffer_to_buffer(&self.positions, 0, &self.readback, 0, bytes);
+        }
+        queue.submit([encoder.finish()]);
+        if bytes == 0 {
+            return Ok(());
+        }
+        let slice = self.readback.slice(..bytes);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = sender.send(r);
+        });
+        let failed = |e: &dyn std::fmt::Display| RenderError::Readback(e.to_string());
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| failed(&e))?;
+        receiver
+            .recv()
+            .map_err(|e| failed(&e))?
+            .map_err(|e| failed(&e))?;
+        {
+            let data = slice.get_mapped_range().map_err(|e| failed(&e))?;
+            let lanes: &[[f32; 4]] = bytemuck::cast_slice(&data);
+            for (o, p) in out.iter_mut().zip(lanes) {
+                let d = Vector3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+                *o = frame.centre + d;
+            }
+        }
+        self.readback.unmap();
+        Ok(())
+    }
+}
+
+/// Each block as u32 words: its first control point, then its factors' f32 bits.
+fn pack_blocks(stencil: &TensorStencil) -> Vec<u32> {
+    let per = 2 * stencil.order();
+    let mut words = Vec::with_capacity(stencil.blocks() * (1 + per));
+    for (first, factors) in stencil
+        .firsts()
+        .iter()
+        .zip(stencil.factors().chunks_exact(per))
+    {
+        words.push(*first);
+        words.extend(factors.iter().map(|f| f.to_bits()));
+    }
+    words
+}
+
+fn padded(words: &[u32]) -> &[u32] {
+    if words.is_empty() { &[0] } else { words }
+}
+
+fn too_many(rows: usize) -> RenderError {
+    RenderError::Mesh(format!(
+        "{rows} rows are more than a GPU dispatch can index"
+    ))
+}
