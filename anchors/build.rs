@@ -24,7 +24,7 @@ fn main() {
         .cpp(true)
         .std("c++14")
         .include(&include)
-        .opt_level(2)
+        .opt_level(3)
         .warnings(false)
         .file("src/osd_shim.cpp")
         .try_compile("ntori_osd_shim");

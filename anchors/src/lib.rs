@@ -211,6 +211,45 @@ impl StencilTable {
         }
     }
 
+    /// [`StencilTable::apply`] on (x, y, z, w) points: the evaluator's SIMD kernel for 4 floats.
+    pub fn apply4(&self, src: &[[f32; 4]], dst: &mut [[f32; 4]]) -> Result<(), Error> {
+        assert_eq!(
+            src.len(),
+            self.base_vertices,
+            "one source point per base vertex"
+        );
+        assert_eq!(dst.len(), self.rows, "one output point per stencil");
+        // SAFETY: src holds the base vertices, dst one float4 per stencil (checked above).
+        let ok = unsafe {
+            sys::ntori_osd_apply4(
+                self.raw,
+                src.as_ptr().cast(),
+                dst.as_mut_ptr().cast(),
+                0,
+                self.rows as i32,
+            )
+        };
+        if ok == 1 {
+            Ok(())
+        } else {
+            Err(Error::Failed("apply stencils"))
+        }
+    }
+
+    /// [`StencilTable::apply`] through Far's own `StencilTable::UpdateValues` template (inlined
+    /// into the shim) instead of the CPU evaluator.
+    pub fn update_values(&self, src: &[[f32; 3]], dst: &mut [[f32; 3]]) -> Result<(), Error> {
+        if !available() {
+            return Err(Error::Unavailable);
+        }
+        self.check(src, &[&*dst]);
+        // SAFETY: as in apply.
+        unsafe {
+            sys::ntori_osd_update_values(self.raw, src.as_ptr().cast(), dst.as_mut_ptr().cast())
+        };
+        Ok(())
+    }
+
     /// [`StencilTable::apply`] with the first derivatives, for limit stencils made with them.
     pub fn apply_with_derivatives(
         &self,
@@ -285,6 +324,22 @@ mod tests {
                 let mut b = a.clone();
                 table.apply(&cage.positions, &mut a).unwrap();
                 table.apply(&moved, &mut b).unwrap();
+                // Far's template and the evaluator's 4-float kernel give the same points.
+                let mut c = a.clone();
+                table.update_values(&cage.positions, &mut c).unwrap();
+                let four: Vec<[f32; 4]> = cage
+                    .positions
+                    .iter()
+                    .map(|p| [p[0], p[1], p[2], 1.0])
+                    .collect();
+                let mut d = vec![[0.0; 4]; table.rows()];
+                table.apply4(&four, &mut d).unwrap();
+                for ((p, q), r) in a.iter().zip(&c).zip(&d) {
+                    for k in 0..3 {
+                        assert!((p[k] - q[k]).abs() < 1e-5 && (p[k] - r[k]).abs() < 1e-5);
+                    }
+                    assert!((r[3] - 1.0).abs() < 1e-5, "weights sum to one");
+                }
                 for (p, q) in a.iter().zip(&b) {
                     let want = [2.0 * p[0] + 1.0, 2.0 * p[1], 2.0 * p[2] - 3.0];
                     for d in 0..3 {

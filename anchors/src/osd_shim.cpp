@@ -146,6 +146,36 @@ int ntori_osd_apply(const void *table, const float *src, float *dst, int start, 
                : 0;
 }
 
+// ntori_osd_apply on float4 points (x, y, z, w): the CPU evaluator's SIMD kernel for 4-float data.
+int ntori_osd_apply4(const void *table, const float *src, float *dst, int start, int end) {
+    Far::StencilTableReal<float> const *st = static_cast<Table const *>(table)->stencils;
+    Osd::BufferDescriptor desc(0, 4, 4);
+    return Osd::CpuEvaluator::EvalStencils(src, desc, dst, desc, &st->GetSizes()[0],
+                                           &st->GetOffsets()[0], &st->GetControlIndices()[0],
+                                           &st->GetWeights()[0], start, end)
+               ? 1
+               : 0;
+}
+
+namespace {
+// A float3 primvar for Far's templated UpdateValues (inlined here, compiled with the shim).
+struct Point {
+    float p[3];
+    void Clear() { p[0] = p[1] = p[2] = 0.0f; }
+    void AddWithWeight(Point const &src, float w) {
+        p[0] += w * src.p[0];
+        p[1] += w * src.p[1];
+        p[2] += w * src.p[2];
+    }
+};
+}  // namespace
+
+// The same as ntori_osd_apply through Far's own StencilTable::UpdateValues template.
+void ntori_osd_update_values(const void *table, const float *src, float *dst) {
+    Far::StencilTableReal<float> const *st = static_cast<Table const *>(table)->stencils;
+    st->UpdateValues(reinterpret_cast<Point const *>(src), reinterpret_cast<Point *>(dst));
+}
+
 // As ntori_osd_apply, with the first derivatives into du and dv (limit stencils made with them).
 int ntori_osd_apply_with_derivatives(const void *table, const float *src, float *dst, float *du,
                                      float *dv, int start, int end) {

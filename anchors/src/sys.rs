@@ -39,6 +39,14 @@ mod linked {
             start: i32,
             end: i32,
         ) -> i32;
+        pub fn ntori_osd_apply4(
+            table: *const c_void,
+            src: *const f32,
+            dst: *mut f32,
+            start: i32,
+            end: i32,
+        ) -> i32;
+        pub fn ntori_osd_update_values(table: *const c_void, src: *const f32, dst: *mut f32);
         pub fn ntori_osd_apply_with_derivatives(
             table: *const c_void,
             src: *const f32,
@@ -101,6 +109,16 @@ mod missing {
     ) -> i32 {
         0
     }
+    pub unsafe fn ntori_osd_apply4(
+        _: *const c_void,
+        _: *const f32,
+        _: *mut f32,
+        _: i32,
+        _: i32,
+    ) -> i32 {
+        0
+    }
+    pub unsafe fn ntori_osd_update_values(_: *const c_void, _: *const f32, _: *mut f32) {}
     pub unsafe fn ntori_osd_apply_with_derivatives(
         _: *const c_void,
         _: *const f32,

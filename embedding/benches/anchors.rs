@@ -1,6 +1,7 @@
 //! ntori's stencils side by side with OpenSubdiv's, in one run, as ratios.
 //!
-//! At about 10⁴, 10⁵ and 10⁶ vertices of a genus-g surface (g = 2, or `NTORI_BENCH_GENUS`):
+//! At about 10⁴, 10⁵ and 10⁶ vertices (or `NTORI_BENCH_VERTICES`, a comma-separated list) of a
+//! genus-g surface (g = 2, or `NTORI_BENCH_GENUS`):
 //! - OpenSubdiv 3.5: Catmull–Clark uniform refinement stencils of a genus-g quad cage at the level
 //!   with that many vertices, and limit stencils (with and without first derivatives) at as many
 //!   points; the factories' time per point and the CPU evaluator's vertices per second.
@@ -30,11 +31,17 @@ fn main() {
         .ok()
         .and_then(|g| g.parse().ok())
         .unwrap_or(2);
-    let (targets, runs): (&[usize], usize) = if full {
-        (&[10_000, 100_000, 1_000_000], 7)
+    let (mut targets, runs) = if full {
+        (vec![10_000, 100_000, 1_000_000], 7)
     } else {
-        (&[10_000], 1)
+        (vec![10_000], 1)
     };
+    if let Ok(list) = std::env::var("NTORI_BENCH_VERTICES") {
+        targets = list
+            .split(',')
+            .filter_map(|n| n.trim().parse().ok())
+            .collect();
+    }
     if anchors::available() {
         println!("OpenSubdiv 3.5 (system libosd), genus {genus}, best of {runs} runs");
     } else if std::env::var_os("NTORI_REQUIRE_TOOLS").is_some() {
@@ -55,7 +62,7 @@ fn main() {
     let atlas = Atlas::new(genus).expect("genus ≤ 64");
     let layout = Layout::new(&atlas, SplineSettings::default()).expect("default settings");
     let control = controls(&layout);
-    for &target in targets {
+    for &target in &targets {
         let level = (1..=8)
             .min_by_key(|&l| {
                 (cage.refined_vertex_count(l) as f64 / target as f64)
@@ -68,15 +75,41 @@ fn main() {
         println!("== {vertices} vertices (OpenSubdiv uniform level {level})");
         let osd = Osd::measure(&cage, level, vertices, runs);
         let pts = tessellation_points(&atlas, vertices);
-        let ours = Ntori::measure(&layout, &control, &pts, runs, &one);
+        // OpenSubdiv's fastest way, run in turns with ntori's tensor stencil so that both see the
+        // same machine (it is shared, and its speed changes from minute to minute).
+        let mut rival = osd.uniform.as_ref().map(|u| {
+            let mut out = vec![[0f32; 3]; u.table.rows()];
+            let cage = &cage;
+            move || {
+                u.table
+                    .update_values(&cage.positions, &mut out)
+                    .expect("applies")
+            }
+        });
+        let rival = rival.as_mut().map(|f| f as &mut dyn FnMut());
+        let ours = Ntori::measure(&layout, &control, &pts, runs, &one, rival);
         report(&osd, &ours, triad, cores);
+    }
+}
+
+/// OpenSubdiv's uniform stencils: vertices/s by the evaluator on float3, on float4, and by Far's
+/// UpdateValues; the factory's µs per vertex; bytes per vertex.
+struct Uniform {
+    table: anchors::StencilTable,
+    rates: [f64; 3],
+    build: f64,
+    bytes: f64,
+}
+
+impl Uniform {
+    fn fastest(&self) -> f64 {
+        self.rates.into_iter().fold(0.0, f64::max)
     }
 }
 
 /// OpenSubdiv's figures at one size (None where OpenSubdiv is not linked).
 struct Osd {
-    /// Uniform stencils: vertices/s applied, factory µs per vertex, bytes per vertex.
-    uniform: Option<(f64, f64, f64)>,
+    uniform: Option<Uniform>,
     /// Limit stencils: vertices/s applied, factory µs per point; the same with derivatives.
     limit: Option<(f64, f64)>,
     limit_derivatives: Option<(f64, f64)>,
@@ -89,15 +122,28 @@ impl Osd {
             refiner.refine_uniform(level).ok()?;
             let (table, build) = timed(|| refiner.stencils());
             let table = table.ok()?;
+            // OpenSubdiv's fastest of three ways to apply them, run in turns: the CPU evaluator on
+            // float3 and on float4 (its SIMD kernel), and Far's UpdateValues template.
             let mut out = vec![[0f32; 3]; table.rows()];
-            let apply = best_of(runs, || {
-                table.apply(&cage.positions, &mut out).expect("applies")
-            });
-            Some((
-                table.rows() as f64 / apply,
-                1e6 * build / table.rows() as f64,
-                table.bytes_per_row(),
-            ))
+            let four: Vec<[f32; 4]> = cage
+                .positions
+                .iter()
+                .map(|p| [p[0], p[1], p[2], 0.0])
+                .collect();
+            let mut out4 = vec![[0f32; 4]; table.rows()];
+            let mut best = [f64::INFINITY; 3];
+            for _ in 0..runs {
+                best[0] = best[0].min(timed(|| table.apply(&cage.positions, &mut out)).1);
+                best[1] = best[1].min(timed(|| table.apply4(&four, &mut out4)).1);
+                best[2] = best[2].min(timed(|| table.update_values(&cage.positions, &mut out)).1);
+            }
+            let rates = best.map(|secs| table.rows() as f64 / secs);
+            Some(Uniform {
+                rates,
+                build: 1e6 * build / table.rows() as f64,
+                bytes: table.bytes_per_row(),
+                table,
+            })
         })();
         let k = ((vertices as f64 / cage.faces.len() as f64).sqrt().round() as u32).max(1);
         let locations = cage.limit_locations(k);
@@ -135,6 +181,8 @@ struct Ntori {
     /// fraction of the bounding-box diagonal.
     tensor_build: (f64, f64),
     tensor_apply: (f64, f64),
+    /// OpenSubdiv's Far UpdateValues, vertices/s, timed in turns with the tensor stencil.
+    rival: Option<f64>,
     tensor_bytes: f64,
     tensor_blocks: f64,
     tensor_error: f64,
@@ -151,6 +199,7 @@ impl Ntori {
         pts: &[ChartPoint],
         runs: usize,
         one: &rayon::ThreadPool,
+        mut rival: Option<&mut dyn FnMut()>,
     ) -> Ntori {
         let n = pts.len() as f64;
         let build_runs = runs.min(3);
@@ -161,7 +210,13 @@ impl Ntori {
         let mut full = Stencil::default();
         let full_build = best_of(build_runs.min(2), || full = Stencil::build(layout, pts));
         let mut out = vec![Point3::origin(); pts.len()];
-        let apply_one = best_of(runs, || tensor.positions(black_box(control), &mut out));
+        let (mut apply_one, mut rival_secs) = (f64::INFINITY, f64::INFINITY);
+        for _ in 0..runs {
+            apply_one = apply_one.min(timed(|| tensor.positions(black_box(control), &mut out)).1);
+            if let Some(rival) = rival.as_mut() {
+                rival_secs = rival_secs.min(timed(|| rival()).1);
+            }
+        }
         let apply_all = best_of(runs, || {
             tensor.positions_parallel(black_box(control), &mut out)
         });
@@ -186,6 +241,7 @@ impl Ntori {
             vertices: pts.len(),
             tensor_build: (1e6 * build_one / n, 1e6 * build_all / n),
             tensor_apply: (n / apply_one, n / apply_all),
+            rival: rival.map(|_| n / rival_secs),
             tensor_bytes: tensor.bytes_per_row(),
             tensor_blocks: tensor.blocks() as f64 / n,
             tensor_error: error / diagonal,
@@ -199,17 +255,22 @@ impl Ntori {
 fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
     let m = |x: f64| format!("{:.1} M/s", x / 1e6);
     let ratio = |a: f64, b: Option<f64>| b.map_or("—".into(), |b| format!("{:.2}×", a / b));
-    let osd_uniform = osd.uniform.map(|u| u.0);
+    let osd_uniform = osd.uniform.as_ref().map(Uniform::fastest);
     println!(
-        "  re-embedding, one thread (vertices/s; ratio = ntori ÷ OpenSubdiv uniform stencils)"
+        "  re-embedding, one thread (vertices/s; ratio = ntori ÷ OpenSubdiv's fastest uniform)"
     );
-    if let Some((rate, _, bytes)) = osd.uniform {
-        println!(
-            "    OpenSubdiv uniform stencils   {:>10}  {:.0} B/vertex  {:.2} of triad",
-            m(rate),
-            bytes,
-            rate * bytes / triad
-        );
+    if let Some(u) = &osd.uniform {
+        for (name, rate) in ["evaluator, float3", "evaluator, float4", "Far UpdateValues"]
+            .iter()
+            .zip(u.rates)
+        {
+            println!(
+                "    OpenSubdiv uniform, {name:<18}{:>10}  {:.0} B/vertex  {:.2} of triad",
+                m(rate),
+                u.bytes,
+                rate * u.bytes / triad
+            );
+        }
     }
     if let Some((rate, _)) = osd.limit {
         println!("    OpenSubdiv limit stencils     {:>10}", m(rate));
@@ -227,6 +288,14 @@ fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
         ours.tensor_blocks,
         ours.tensor_error
     );
+    if let Some(rival) = ours.rival {
+        println!(
+            "    in turns: ntori tensor {} against OpenSubdiv Far UpdateValues {}: {:.2}×",
+            m(one),
+            m(rival),
+            one / rival
+        );
+    }
     println!(
         "    ntori full f64 stencil        {:>10}  {}",
         m(ours.full_positions),
@@ -243,8 +312,8 @@ fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
         all / one
     );
     println!("  stencil build (µs per point; ratio = OpenSubdiv's limit factory ÷ ntori)");
-    if let Some((_, build, _)) = osd.uniform {
-        println!("    OpenSubdiv uniform factory    {build:>8.3}");
+    if let Some(u) = &osd.uniform {
+        println!("    OpenSubdiv uniform factory    {:>8.3}", u.build);
     }
     let limit = osd.limit.map(|l| l.1);
     if let Some(b) = limit {

@@ -159,7 +159,8 @@ impl GpuReembed {
             "the stencil's control points"
         );
         let frame = ControlFrame::new(control);
-        queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&frame.points));
+        let lanes: Vec<[f32; 4]> = frame.points.iter().map(|v| v.to_array()).collect();
+        queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&lanes));
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

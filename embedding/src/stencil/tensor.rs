@@ -13,6 +13,7 @@
 //! `embedding/tests/surface.rs` (at most 1e-6 of the bounding-box diagonal).
 
 use charts::ChartPoint;
+use glam::Vec4;
 use rayon::prelude::*;
 
 use crate::surface::{Layout, Point3, Vector3};
@@ -22,6 +23,10 @@ use crate::surface::{Layout, Point3, Vector3};
 /// distance between the left-out patch and the blend of the others (a patch disagreement, far below
 /// the model's size): under 1e-7 of the diagonal.
 pub const NEGLIGIBLE_BLEND: f64 = 1e-7;
+
+/// How many blocks ahead the kernel asks for its factors: the hardware's stream prefetcher alone
+/// left the kernel waiting on memory half the time once the stencil outgrew the caches.
+const PREFETCH_BLOCKS: usize = 16;
 
 /// Rows per parallel task: enough to amortise scheduling, few enough to balance the cores.
 const ROWS_PER_TASK: usize = 4096;
@@ -137,6 +142,23 @@ impl TensorStencil {
 
     /// Rows `first_row..first_row + out.len()`, by a copy of the kernel for this order.
     fn rows_into(&self, frame: &ControlFrame, first_row: usize, out: &mut [Point3]) {
+        #[cfg(target_arch = "x86_64")]
+        if self.order == 4 && simd::available() {
+            // SAFETY: the CPU has AVX and FMA (checked just now).
+            return unsafe { simd::cubic_rows(self, frame, first_row, out) };
+        }
+        self.portable_rows(frame, first_row, out);
+    }
+
+    /// [`TensorStencil::positions`] by the portable kernel alone, even where the cubic one with AVX
+    /// and FMA would run: for tests that compare the two.
+    #[doc(hidden)]
+    pub fn positions_portable(&self, control: &[Point3], out: &mut [Point3]) {
+        let frame = ControlFrame::new(control);
+        self.portable_rows(&frame, 0, &mut out[..self.rows()]);
+    }
+
+    fn portable_rows(&self, frame: &ControlFrame, first_row: usize, out: &mut [Point3]) {
         match self.order {
             2 => self.kernel::<2>(frame, first_row, out),
             3 => self.kernel::<3>(frame, first_row, out),
@@ -156,32 +178,102 @@ impl TensorStencil {
         }
         let starts = &self.row_starts[first_row..=first_row + out.len()];
         for (o, span) in out.iter_mut().zip(starts.windows(2)) {
-            let mut acc = [0f32; 4];
+            let mut acc = Vec4::ZERO;
             for k in span[0] as usize..span[1] as usize {
+                prefetch(&self.factors, 2 * O * (k + PREFETCH_BLOCKS));
                 let factors = &self.factors[2 * O * k..2 * O * (k + 1)];
                 let (u, v) = factors.split_at(O);
                 let u: &[f32; O] = u.try_into().expect("order factors");
+                let v: &[f32; O] = v.try_into().expect("order factors");
                 let first = self.firsts[k] as usize;
                 for (j, &vj) in v.iter().enumerate() {
                     let start = first + j * self.grid;
-                    let line: &[[f32; 4]; O] = frame.points[start..start + O]
+                    let line: &[Vec4; O] = frame.points[start..start + O]
                         .try_into()
                         .expect("a block line");
-                    let mut s = [0f32; 4];
-                    for (ui, c) in u.iter().zip(line) {
-                        for d in 0..4 {
-                            s[d] += ui * c[d];
-                        }
+                    let mut s = Vec4::ZERO;
+                    for (&ui, &c) in u.iter().zip(line) {
+                        s += c * ui;
                     }
-                    for d in 0..4 {
-                        acc[d] += vj * s[d];
-                    }
+                    acc += s * vj;
                 }
             }
-            *o = frame.centre
-                + Vector3::new(f64::from(acc[0]), f64::from(acc[1]), f64::from(acc[2]));
+            let d = Vector3::new(f64::from(acc.x), f64::from(acc.y), f64::from(acc.z));
+            *o = frame.centre + d;
         }
     }
+}
+
+/// The cubic kernel with 256-bit registers: two control points (x, y, z, 0) per register, and
+/// fused multiply-adds. About half the instructions of the portable kernel per block.
+#[cfg(target_arch = "x86_64")]
+mod simd {
+    use std::arch::x86_64::*;
+
+    use super::{ControlFrame, PREFETCH_BLOCKS, Point3, TensorStencil, Vector3, prefetch};
+
+    pub(super) fn available() -> bool {
+        is_x86_feature_detected!("avx") && is_x86_feature_detected!("fma")
+    }
+
+    /// Rows `first_row..first_row + out.len()` of a cubic (order 4) stencil.
+    #[target_feature(enable = "avx,fma")]
+    pub(super) fn cubic_rows(
+        stencil: &TensorStencil,
+        frame: &ControlFrame,
+        first_row: usize,
+        out: &mut [Point3],
+    ) {
+        if out.is_empty() {
+            return;
+        }
+        let starts = &stencil.row_starts[first_row..=first_row + out.len()];
+        for (o, span) in out.iter_mut().zip(starts.windows(2)) {
+            let mut acc = _mm256_setzero_ps();
+            for k in span[0] as usize..span[1] as usize {
+                prefetch(&stencil.factors, 8 * (k + PREFETCH_BLOCKS));
+                let f: &[f32; 8] = stencil.factors[8 * k..8 * k + 8]
+                    .try_into()
+                    .expect("cubic factors");
+                // (u₀ ×4, u₁ ×4) and (u₂ ×4, u₃ ×4): the weights of two control points each.
+                let u01 = _mm256_set_m128(_mm_set1_ps(f[1]), _mm_set1_ps(f[0]));
+                let u23 = _mm256_set_m128(_mm_set1_ps(f[3]), _mm_set1_ps(f[2]));
+                let first = stencil.firsts[k] as usize;
+                for (j, &v) in f[4..].iter().enumerate() {
+                    let start = first + j * stencil.grid;
+                    let line = &frame.points[start..start + 4];
+                    let p = line.as_ptr().cast::<f32>();
+                    // SAFETY: `line` is 4 Vec4s, 16 contiguous f32; the loads read floats 0–7 and
+                    // 8–15 of it.
+                    let (c01, c23) = unsafe { (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8))) };
+                    let s = _mm256_fmadd_ps(c23, u23, _mm256_mul_ps(c01, u01));
+                    acc = _mm256_fmadd_ps(s, _mm256_set1_ps(v), acc);
+                }
+            }
+            let sum = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps::<1>(acc));
+            let mut lanes = [0f32; 4];
+            // SAFETY: `lanes` holds the 4 floats stored.
+            unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), sum) };
+            let [x, y, z, _] = lanes.map(f64::from);
+            *o = frame.centre + Vector3::new(x, y, z);
+        }
+    }
+}
+
+/// Asks the cache for `data[at]` (nothing where it is out of range, or off x86-64).
+#[inline(always)]
+fn prefetch(data: &[f32], at: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(x) = data.get(at) {
+        // SAFETY: a prefetch is only a hint; the address is of a live element.
+        unsafe {
+            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+                std::ptr::from_ref(x).cast(),
+            )
+        };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (data, at);
 }
 
 impl Part {
@@ -231,7 +323,8 @@ impl Part {
 /// tensor stencil is applied to, here or on a GPU.
 pub struct ControlFrame {
     pub centre: Point3,
-    pub points: Vec<[f32; 4]>,
+    /// 16-byte SIMD lanes (glam's `Vec4`), so a line of a block is a few aligned vector loads.
+    pub points: Vec<Vec4>,
 }
 
 impl ControlFrame {
@@ -247,7 +340,7 @@ impl ControlFrame {
             .iter()
             .map(|c| {
                 let d = c - centre;
-                [d.x as f32, d.y as f32, d.z as f32, 0.0]
+                Vec4::new(d.x as f32, d.y as f32, d.z as f32, 0.0)
             })
             .collect();
         ControlFrame { centre, points }
