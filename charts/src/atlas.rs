@@ -313,6 +313,23 @@ impl Atlas {
         reps
     }
 
+    /// [`Atlas::locate_unchecked`]'s representations, written into `out` (cleared first) without
+    /// allocating: for loops over many points that reuse one buffer. Sorted by chart.
+    pub fn locate_into(&self, p: ChartPoint, out: &mut Vec<ChartPoint>) {
+        let i = p.chart.index();
+        let n = self.charts.len();
+        out.clear();
+        out.push(p);
+        for &(j, k) in self.locators[i].candidates(p.coords) {
+            let t = &self.transitions[i * n + j as usize][k as usize];
+            let w = t.apply(p.coords);
+            if self.charts[j as usize].domain.contains(w) {
+                out.push(ChartPoint::new(t.to, w));
+            }
+        }
+        out.sort_unstable_by_key(|r| r.chart);
+    }
+
     /// The surface point of a model-space point (any point of the disk, plane, or finite sphere
     /// coordinate): reduced into the polygon, then mapped into every chart through that chart's tiles.
     pub fn locate_model(&self, z: ModelPoint) -> ManifoldPoint {

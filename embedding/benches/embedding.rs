@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use charts::{Atlas, ChartPoint};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use embedding::{Layout, Point3, SplineSettings, Stencil, Vector3};
+use embedding::{Layout, Point3, SplineSettings, Stencil, TensorStencil, Vector3};
 
 const SIZES: [usize; 3] = [10_000, 100_000, 1_000_000];
 
@@ -60,6 +60,21 @@ fn direct_and_build(c: &mut Criterion) {
         });
     }
     build.finish();
+    // The positions-only tensor stencil, on one thread (as OpenSubdiv's factories run).
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let mut tensor = c.benchmark_group("tensor_stencil_build");
+    tensor.sample_size(10);
+    for n in SIZES {
+        let pts = points(&atlas, n);
+        tensor.throughput(Throughput::Elements(pts.len() as u64));
+        tensor.bench_with_input(BenchmarkId::from_parameter(n), &pts, |b, pts| {
+            b.iter(|| one.install(|| TensorStencil::build(&layout, black_box(pts)).blocks()))
+        });
+    }
+    tensor.finish();
 }
 
 fn reembed(c: &mut Criterion) {

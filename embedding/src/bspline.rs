@@ -61,10 +61,7 @@ impl UniformBasis {
     pub fn eval(&self, x: f64, derivs: usize) -> (usize, [[f64; MAX_DEGREE + 1]; 4]) {
         let p = self.degree;
         let derivs = derivs.min(p).min(3);
-        let x = x.clamp(-0.5, 0.5);
-        // Knot span: t_span ≤ x < t_{span+1}, span ∈ [p, count − 1].
-        let span = (((x + 0.5) / self.h).floor() as usize + p).min(self.count - 1);
-        let t = (x - self.knot(span as isize)) / self.h;
+        let (span, t) = self.span(x);
         // One copy per degree: the loops unroll and the bounds checks go.
         let table = match p {
             1 => span_table::<1>(t, derivs, self.h),
@@ -77,6 +74,51 @@ impl UniformBasis {
         };
         (span - p, table)
     }
+
+    /// [`UniformBasis::eval`]'s values alone (its `table[0]`, the same numbers), without the
+    /// derivatives' table: for the tensor stencil, which needs only positions.
+    pub fn values(&self, x: f64) -> (usize, [f64; MAX_DEGREE + 1]) {
+        let p = self.degree;
+        let (span, t) = self.span(x);
+        (span - p, unit_values(p, t))
+    }
+
+    /// The knot span of x (clamped to the domain), t_span ≤ x < t_{span+1} with span ∈ [p,
+    /// count − 1], and x's local parameter t ∈ [0, 1] in it.
+    fn span(&self, x: f64) -> (usize, f64) {
+        let x = x.clamp(-0.5, 0.5);
+        let span = (((x + 0.5) / self.h).floor() as usize + self.degree).min(self.count - 1);
+        (span, (x - self.knot(span as isize)) / self.h)
+    }
+}
+
+/// The top row of [`unit_triangle`] (degree p), without the rows below.
+fn unit_values(p: usize, t: f64) -> [f64; MAX_DEGREE + 1] {
+    match p {
+        0 => unit_values_of::<0>(t),
+        1 => unit_values_of::<1>(t),
+        2 => unit_values_of::<2>(t),
+        3 => unit_values_of::<3>(t),
+        4 => unit_values_of::<4>(t),
+        5 => unit_values_of::<5>(t),
+        6 => unit_values_of::<6>(t),
+        _ => unit_values_of::<MAX_DEGREE>(t),
+    }
+}
+
+/// The top row of [`unit_triangle_of`]: Cox–de Boor's recurrence in place, each degree's row
+/// overwriting the one below from the right, with the same arithmetic (so the same numbers).
+fn unit_values_of<const P: usize>(t: f64) -> [f64; MAX_DEGREE + 1] {
+    let mut n = [0.0; MAX_DEGREE + 1];
+    n[0] = 1.0;
+    for k in 1..=P {
+        let inv = 1.0 / k as f64;
+        for j in (0..=k).rev() {
+            let below = if j > 0 { n[j - 1] } else { 0.0 };
+            n[j] = ((t + (k - j) as f64) * below + (j as f64 + 1.0 - t) * n[j]) * inv;
+        }
+    }
+    n
 }
 
 /// Zeros before each row of [`unit_triangle`], so that differences of up to third order need no
@@ -155,7 +197,7 @@ pub fn cardinal_value(d: usize, x: f64) -> f64 {
     if !(0.0..=d as f64).contains(&m) {
         return 0.0;
     }
-    unit_triangle(d, y - m)[d][PAD + d - m as usize]
+    unit_values(d, y - m)[d - m as usize]
 }
 
 /// The cardinal B-spline of degree d on the knots 0, 1/(d+1), …, 1, and its derivatives up to order
@@ -283,6 +325,8 @@ mod tests {
             let (first, fast) = b.eval(x, 3);
             let (first_ref, slow) = piegl_tiller(&b, x, 3);
             prop_assert_eq!(first, first_ref);
+            // The values alone are the table's first row, to the bit.
+            prop_assert_eq!(b.values(x), (first, fast[0]));
             // Each derivative order scales by h⁻¹.
             let mut scale: f64 = 1.0;
             for d in 0..=p.min(3) {

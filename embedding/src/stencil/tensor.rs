@@ -287,31 +287,26 @@ impl Part {
             factors: Vec::with_capacity(6 * order * points.len()),
         };
         let mut blends: Vec<(ChartPoint, f64)> = Vec::with_capacity(16);
+        let mut reps: Vec<ChartPoint> = Vec::with_capacity(16);
         for &p in points {
+            layout.atlas().locate_into(p, &mut reps);
             blends.clear();
-            blends.extend(
-                layout
-                    .atlas()
-                    .locate_with_transitions(p)
-                    .into_iter()
-                    .map(|(rep, _)| {
-                        let domain = charts[rep.chart.index()].domain();
-                        (rep, layout.raw_blend_value(domain, rep.coords))
-                    }),
-            );
+            blends.extend(reps.iter().map(|&rep| {
+                let domain = charts[rep.chart.index()].domain();
+                (rep, layout.raw_blend_value(domain, rep.coords))
+            }));
             let total: f64 = blends.iter().map(|b| b.1).sum();
             blends.retain(|b| b.1 >= NEGLIGIBLE_BLEND * total);
             let kept: f64 = blends.iter().map(|b| b.1).sum();
             for &(rep, blend) in &blends {
                 let beta = blend / kept;
-                let (fu, nu) = basis.eval(rep.coords.re, 0);
-                let (fv, nv) = basis.eval(rep.coords.im, 0);
+                let (fu, nu) = basis.values(rep.coords.re);
+                let (fv, nv) = basis.values(rep.coords.im);
                 part.firsts
                     .push(layout.control_index(rep.chart, fu, fv) as u32);
+                part.factors.extend(nu[..order].iter().map(|&x| x as f32));
                 part.factors
-                    .extend(nu[0][..order].iter().map(|&x| x as f32));
-                part.factors
-                    .extend(nv[0][..order].iter().map(|&y| (beta * y) as f32));
+                    .extend(nv[..order].iter().map(|&y| (beta * y) as f32));
             }
             part.blocks_per_row.push(blends.len() as u32);
         }
