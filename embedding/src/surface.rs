@@ -293,12 +293,14 @@ impl<'a> Layout<'a> {
             let (fu, nu) = self.basis.eval(w.re, 2);
             let (fv, nv) = self.basis.eval(w.im, 2);
             // (value, first, second derivative) of each of the p + 1 basis functions alive here.
-            let triples = |n: &[[f64; crate::bspline::MAX_DEGREE + 1]; 4]| -> Vec<[f64; 3]> {
-                (0..p1).map(|k| [n[0][k], n[1][k], n[2][k]]).collect()
+            let triples = |n: &[[f64; crate::bspline::MAX_DEGREE + 1]; 4]| {
+                std::array::from_fn::<[f64; 3], { crate::bspline::MAX_DEGREE + 1 }, _>(|k| {
+                    [n[0][k], n[1][k], n[2][k]]
+                })
             };
             let (bu, bv) = (triples(&nu), triples(&nv));
-            for (j, y) in bv.iter().enumerate() {
-                for (i, x) in bu.iter().enumerate() {
+            for (j, y) in bv[..p1].iter().enumerate() {
+                for (i, x) in bu[..p1].iter().enumerate() {
                     let basis = Jet::tensor(*x, *y);
                     out.push(Weight {
                         control: self.control_index(rep.chart, fu + i, fv + j) as u32,

@@ -22,6 +22,8 @@
 //! point first move by Δ times a smooth falloff (1 at the point, 0 at the radius), then the
 //! minimum-norm correction makes the dragged point and the pins exact again.
 
+use std::time::Duration;
+
 use charts::ChartPoint;
 use embedding::edit::{Constraint, solve};
 use embedding::{ControlId, EmbeddingError, Layout, Point3, Surface, Vector3};
@@ -30,6 +32,42 @@ use bytemuck::{Pod, Zeroable};
 
 use super::mesh::{LiveMesh, ViewVertex};
 use embedding::evaluate::parallel_chunks;
+
+/// What a press in the viewport grabbed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Grab {
+    /// A surface point (not pinned).
+    Surface,
+    /// The pin with this index.
+    Pin(usize),
+}
+
+/// A drag in progress: the plan and where the pointer went down.
+#[derive(Clone, Debug)]
+pub struct Drag {
+    pub plan: DragPlan,
+    pub press_pixel: [f64; 2],
+    pub grab: Grab,
+    pub events: u32,
+    /// Time spent in drag events (solve and vertex update), in total and the last one.
+    pub busy: Duration,
+    pub last: Duration,
+}
+
+/// The last finished drag: what moved where, and how long its events took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DragStats {
+    /// The dragged surface point, where it was, and where the last event asked it to go.
+    pub point: ChartPoint,
+    pub start: Point3,
+    pub target: Point3,
+    pub events: u32,
+    pub mean: Duration,
+    pub last: Duration,
+    /// Vertices each event moved and control points it changed.
+    pub vertices: usize,
+    pub controls: usize,
+}
 
 /// A vertex a drag moves, as the GPU reads it: its position and tangents when the drag began, and
 /// its gains (position = base + g Δ, S_u = u + g_u Δ, S_v = v + g_v Δ). 48 bytes.

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
-use embedding::fit::{FitSettings, initial_model};
-use embedding::{EmbeddingError, Point3, SplineSettings, Surface};
+use embedding::fit::{FitSettings, initial_model, vertex_areas};
+use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
-use super::state::{EditorError, refit};
+use super::state::EditorError;
 use crate::io::export::{self, ExportError, Format};
 
 /// Resolution of the input meshes of new models (points around each hole), as `ntori new` uses.
@@ -147,4 +147,38 @@ impl Jobs {
         let job = self.current.take()?;
         Some(job.receiver.recv().unwrap_or(Err(JobError::Stopped)))
     }
+}
+
+/// A model's control points for other spline settings: the new layout fitted (least squares, as the
+/// initial fit does) to the current surface sampled at a tessellation's vertices. Returns the
+/// control points and the largest distance between the two surfaces at the samples.
+pub fn refit(
+    surface: &Surface,
+    settings: SplineSettings,
+) -> Result<(Vec<Point3>, f64), EditorError> {
+    let atlas = surface.atlas();
+    let new = Layout::new(atlas, settings)?;
+    // About four samples per control point along each side of a chart.
+    let t = (2 * settings.grid.max(surface.settings().grid)).clamp(16, 96) as u32;
+    let tessellation = atlas.tessellate(t, t)?;
+    let stencil = embedding::Stencil::build(&surface.layout(), &tessellation.vertices);
+    let mut targets = vec![Point3::origin(); stencil.rows()];
+    stencil.positions(surface.control_points(), &mut targets);
+    let weights = vertex_areas(&targets, &tessellation.triangles);
+    let fitted = embedding::fit::fit(
+        &new,
+        &tessellation.vertices,
+        &targets,
+        &weights,
+        FitSettings::default(),
+    )?;
+    let check = embedding::Stencil::build(&new, &tessellation.vertices);
+    let mut now = vec![Point3::origin(); check.rows()];
+    check.positions(&fitted, &mut now);
+    let worst = now
+        .iter()
+        .zip(&targets)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    Ok((fitted, worst))
 }

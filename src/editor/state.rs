@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
-use embedding::fit::{FitSettings, vertex_areas};
 use embedding::remesh::QualitySettings;
 use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surface, Vector3};
 
 use super::camera::{OrbitCamera, to_point};
+pub use super::drag::{Drag, DragStats, Grab};
 use super::drag::{DragPlan, DragRow};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
@@ -57,42 +57,6 @@ pub struct Pick {
     /// Where the ray met the triangle, and the exact surface point S(point).
     pub on_mesh: Point3,
     pub surface: Point3,
-}
-
-/// What a press in the viewport grabbed.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Grab {
-    /// A surface point (not pinned).
-    Surface,
-    /// The pin with this index.
-    Pin(usize),
-}
-
-/// A drag in progress: the plan and where the pointer went down.
-#[derive(Clone, Debug)]
-pub struct Drag {
-    pub plan: DragPlan,
-    pub press_pixel: [f64; 2],
-    pub grab: Grab,
-    pub events: u32,
-    /// Time spent in drag events (solve and vertex update), in total and the last one.
-    pub busy: Duration,
-    pub last: Duration,
-}
-
-/// The last finished drag: what moved where, and how long its events took.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DragStats {
-    /// The dragged surface point, where it was, and where the last event asked it to go.
-    pub point: ChartPoint,
-    pub start: Point3,
-    pub target: Point3,
-    pub events: u32,
-    pub mean: Duration,
-    pub last: Duration,
-    /// Vertices each event moved and control points it changed.
-    pub vertices: usize,
-    pub controls: usize,
 }
 
 /// The editor's state (see the module documentation).
@@ -613,38 +577,4 @@ fn check_meshing(meshing: Meshing) -> Result<(), EditorError> {
         }
         Meshing::TeTr { .. } => Ok(()),
     }
-}
-
-/// A model's control points for other spline settings: the new layout fitted (least squares, as the
-/// initial fit does) to the current surface sampled at a tessellation's vertices. Returns the
-/// control points and the largest distance between the two surfaces at the samples.
-pub fn refit(
-    surface: &Surface,
-    settings: SplineSettings,
-) -> Result<(Vec<Point3>, f64), EditorError> {
-    let atlas = surface.atlas();
-    let new = Layout::new(atlas, settings)?;
-    // About four samples per control point along each side of a chart.
-    let t = (2 * settings.grid.max(surface.settings().grid)).clamp(16, 96) as u32;
-    let tessellation = atlas.tessellate(t, t)?;
-    let stencil = embedding::Stencil::build(&surface.layout(), &tessellation.vertices);
-    let mut targets = vec![Point3::origin(); stencil.rows()];
-    stencil.positions(surface.control_points(), &mut targets);
-    let weights = vertex_areas(&targets, &tessellation.triangles);
-    let fitted = embedding::fit::fit(
-        &new,
-        &tessellation.vertices,
-        &targets,
-        &weights,
-        FitSettings::default(),
-    )?;
-    let check = embedding::Stencil::build(&new, &tessellation.vertices);
-    let mut now = vec![Point3::origin(); check.rows()];
-    check.positions(&fitted, &mut now);
-    let worst = now
-        .iter()
-        .zip(&targets)
-        .map(|(a, b)| (a - b).norm())
-        .fold(0.0, f64::max);
-    Ok((fitted, worst))
 }
