@@ -193,35 +193,32 @@ impl StencilTable {
 
     /// `dst[i]` = stencil i applied to `src` (OpenSubdiv's single-threaded CPU evaluator).
     pub fn apply(&self, src: &[[f32; 3]], dst: &mut [[f32; 3]]) -> Result<(), Error> {
-        self.check(src, &[&*dst]);
-        // SAFETY: src holds the base vertices, dst one float3 per stencil (checked above).
-        let ok = unsafe {
-            sys::ntori_osd_apply(
-                self.raw,
-                src.as_ptr().cast(),
-                dst.as_mut_ptr().cast(),
-                0,
-                self.rows as i32,
-            )
-        };
-        if ok == 1 {
-            Ok(())
-        } else {
-            Err(Error::Failed("apply stencils"))
-        }
+        self.evaluate(src, dst, sys::ntori_osd_apply)
     }
 
     /// [`StencilTable::apply`] on (x, y, z, w) points: the evaluator's SIMD kernel for 4 floats.
     pub fn apply4(&self, src: &[[f32; 4]], dst: &mut [[f32; 4]]) -> Result<(), Error> {
+        self.evaluate(src, dst, sys::ntori_osd_apply4)
+    }
+
+    /// Every stencil applied to `src` by `kernel` (one of the shim's evaluator calls, for points of
+    /// N floats).
+    fn evaluate<const N: usize>(
+        &self,
+        src: &[[f32; N]],
+        dst: &mut [[f32; N]],
+        kernel: unsafe extern "C" fn(*const c_void, *const f32, *mut f32, i32, i32) -> i32,
+    ) -> Result<(), Error> {
         assert_eq!(
             src.len(),
             self.base_vertices,
             "one source point per base vertex"
         );
         assert_eq!(dst.len(), self.rows, "one output point per stencil");
-        // SAFETY: src holds the base vertices, dst one float4 per stencil (checked above).
+        // SAFETY: src holds the base vertices and dst one point per stencil (checked above), both of
+        // the N floats the kernel reads and writes per point.
         let ok = unsafe {
-            sys::ntori_osd_apply4(
+            kernel(
                 self.raw,
                 src.as_ptr().cast(),
                 dst.as_mut_ptr().cast(),

@@ -65,7 +65,7 @@ mod missing {
     use std::ffi::{c_long, c_void};
     use std::ptr::null_mut;
 
-    pub unsafe fn ntori_osd_refiner_new(
+    pub unsafe extern "C" fn ntori_osd_refiner_new(
         _: i32,
         _: i32,
         _: *const i32,
@@ -73,17 +73,17 @@ mod missing {
     ) -> *mut c_void {
         null_mut()
     }
-    pub unsafe fn ntori_osd_refiner_free(_: *mut c_void) {}
-    pub unsafe fn ntori_osd_refine_uniform(_: *mut c_void, _: i32) -> i32 {
+    pub unsafe extern "C" fn ntori_osd_refiner_free(_: *mut c_void) {}
+    pub unsafe extern "C" fn ntori_osd_refine_uniform(_: *mut c_void, _: i32) -> i32 {
         0
     }
-    pub unsafe fn ntori_osd_refine_adaptive(_: *mut c_void, _: i32) -> i32 {
+    pub unsafe extern "C" fn ntori_osd_refine_adaptive(_: *mut c_void, _: i32) -> i32 {
         0
     }
-    pub unsafe fn ntori_osd_uniform_stencils(_: *const c_void) -> *mut c_void {
+    pub unsafe extern "C" fn ntori_osd_uniform_stencils(_: *const c_void) -> *mut c_void {
         null_mut()
     }
-    pub unsafe fn ntori_osd_limit_stencils(
+    pub unsafe extern "C" fn ntori_osd_limit_stencils(
         _: *const c_void,
         _: i32,
         _: *const i32,
@@ -93,14 +93,14 @@ mod missing {
     ) -> *mut c_void {
         null_mut()
     }
-    pub unsafe fn ntori_osd_stencils_free(_: *mut c_void) {}
-    pub unsafe fn ntori_osd_stencil_count(_: *const c_void) -> i32 {
+    pub unsafe extern "C" fn ntori_osd_stencils_free(_: *mut c_void) {}
+    pub unsafe extern "C" fn ntori_osd_stencil_count(_: *const c_void) -> i32 {
         0
     }
-    pub unsafe fn ntori_osd_weight_count(_: *const c_void) -> c_long {
+    pub unsafe extern "C" fn ntori_osd_weight_count(_: *const c_void) -> c_long {
         0
     }
-    pub unsafe fn ntori_osd_apply(
+    pub unsafe extern "C" fn ntori_osd_apply(
         _: *const c_void,
         _: *const f32,
         _: *mut f32,
@@ -109,7 +109,7 @@ mod missing {
     ) -> i32 {
         0
     }
-    pub unsafe fn ntori_osd_apply4(
+    pub unsafe extern "C" fn ntori_osd_apply4(
         _: *const c_void,
         _: *const f32,
         _: *mut f32,
@@ -118,8 +118,9 @@ mod missing {
     ) -> i32 {
         0
     }
-    pub unsafe fn ntori_osd_update_values(_: *const c_void, _: *const f32, _: *mut f32) {}
-    pub unsafe fn ntori_osd_apply_with_derivatives(
+    pub unsafe extern "C" fn ntori_osd_update_values(_: *const c_void, _: *const f32, _: *mut f32) {
+    }
+    pub unsafe extern "C" fn ntori_osd_apply_with_derivatives(
         _: *const c_void,
         _: *const f32,
         _: *mut f32,

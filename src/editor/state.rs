@@ -502,7 +502,7 @@ impl EditorState {
         Ok(())
     }
 
-    /// New spline settings with their control points (e.g. from [`refit`]): an undoable change.
+    /// New spline settings with their control points (e.g. from [`refit`](super::jobs::refit())): an undoable change.
     pub fn set_settings(
         &mut self,
         settings: SplineSettings,

@@ -125,7 +125,7 @@ pub enum ImportError {
         MeshFormat::EXTENSIONS
     )]
     UnknownFormat { path: PathBuf, extension: String },
-    /// Anything below, found in this file ([`read_mesh`] names the file once).
+    /// Anything below, found in this file ([`super::read_mesh`] names the file once).
     #[error("cannot read {}: {error}", .path.display())]
     InFile {
         path: PathBuf,
