@@ -1,4 +1,5 @@
-//! Everything ntori reads from or writes to files: atomic writes ([`atomic`]), model files
+//! Everything ntori reads from or writes to files: atomic writes ([`atomic`]), input files read
+//! whole under a size cap ([`input`]), model files
 //! ([`model_file`]), mesh exports ([`export`], one file per format) and users' meshes read and
 //! checked for a fit ([`import`], one file per format).
 //!
@@ -7,4 +8,5 @@
 pub mod atomic;
 pub mod export;
 pub mod import;
+pub mod input;
 pub mod model_file;

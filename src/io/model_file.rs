@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use embedding::{EmbeddingError, Model, ModelHeader, Surface};
 
 use crate::io::atomic::{FileError, write_atomically, write_new_with};
+use crate::io::input::{self, InputProblem};
 
 /// The largest model file read, in bytes. A model of genus 64 with 64×64 control grids (the
 /// largest `ntori new` makes) is about 40 MB; a larger file is refused before it is read, so a
@@ -145,42 +146,21 @@ pub fn from_bytes(path: &Path, bytes: &[u8]) -> Result<Surface, ModelFileError> 
 
 /// The file's bytes, if it is a regular file of at most [`MAX_MODEL_BYTES`].
 fn read_capped(path: &Path) -> Result<Vec<u8>, ModelFileError> {
-    use std::io::Read as _;
-    let unreadable = |source: std::io::Error| match source.kind() {
-        std::io::ErrorKind::NotFound => ModelFileError::Missing {
-            path: path.to_owned(),
-        },
-        _ => ModelFileError::Unreadable {
-            path: path.to_owned(),
-            source,
-        },
-    };
-    // Before opening: opening a FIFO blocks until someone writes to it.
-    let meta = std::fs::metadata(path).map_err(unreadable)?;
-    if !meta.is_file() {
-        return Err(ModelFileError::NotRegular {
-            path: path.to_owned(),
-            kind: crate::io::atomic::kind_of(&meta.file_type()),
-        });
-    }
-    let too_large = |size| ModelFileError::TooLarge {
-        path: path.to_owned(),
-        size,
-        max: MAX_MODEL_BYTES,
-    };
-    if meta.len() > MAX_MODEL_BYTES {
-        return Err(too_large(meta.len()));
-    }
-    let file = std::fs::File::open(path).map_err(unreadable)?;
-    // The file may grow after the check: read one byte past the cap at most.
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(MAX_MODEL_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(unreadable)?;
-    if bytes.len() as u64 > MAX_MODEL_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(bytes)
+    let read = input::regular_file(path, MAX_MODEL_BYTES)
+        .and_then(|meta| input::read_capped(path, &meta, MAX_MODEL_BYTES));
+    read.map_err(|problem| {
+        let path = path.to_owned();
+        match problem {
+            InputProblem::Missing => ModelFileError::Missing { path },
+            InputProblem::Unreadable(source) => ModelFileError::Unreadable { path, source },
+            InputProblem::NotRegular(kind) => ModelFileError::NotRegular { path, kind },
+            InputProblem::TooLarge(size) => ModelFileError::TooLarge {
+                path,
+                size,
+                max: MAX_MODEL_BYTES,
+            },
+        }
+    })
 }
 
 /// A serde_json error as one line: the field path where known, the problem with long quotes cut,

@@ -34,6 +34,8 @@ use std::path::Path;
 
 use embedding::Point3;
 
+use crate::io::input::{self, InputProblem};
+
 mod error;
 pub mod glb;
 pub mod obj;
@@ -169,51 +171,25 @@ pub fn check_input(path: &Path) -> Result<(), ImportError> {
 
 /// The file's metadata, refusing what is missing, not a regular file, or too large to read.
 fn file_metadata(path: &Path) -> Result<std::fs::Metadata, ImportError> {
-    let meta = std::fs::metadata(path).map_err(|source| match source.kind() {
-        std::io::ErrorKind::NotFound => ImportError::Missing {
-            path: path.to_owned(),
-        },
-        _ => ImportError::Unreadable {
-            path: path.to_owned(),
-            source,
-        },
-    })?;
-    if !meta.is_file() {
-        return Err(ImportError::NotRegular {
-            path: path.to_owned(),
-            kind: crate::io::atomic::kind_of(&meta.file_type()),
-        });
-    }
-    if meta.len() > MAX_MESH_BYTES {
-        return Err(ImportError::TooLargeFile {
-            path: path.to_owned(),
-            size: meta.len(),
-            max: MAX_MESH_BYTES,
-        });
-    }
-    Ok(meta)
+    input::regular_file(path, MAX_MESH_BYTES).map_err(|p| file_error(path, p))
 }
 
 fn read_file(path: &Path, meta: &std::fs::Metadata) -> Result<Vec<u8>, ImportError> {
-    use std::io::Read;
-    let unreadable = |source| ImportError::Unreadable {
-        path: path.to_owned(),
-        source,
-    };
-    let file = std::fs::File::open(path).map_err(unreadable)?;
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    // A file that grew since: read one byte past the limit to know.
-    file.take(MAX_MESH_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(unreadable)?;
-    if bytes.len() as u64 > MAX_MESH_BYTES {
-        return Err(ImportError::TooLargeFile {
-            path: path.to_owned(),
-            size: bytes.len() as u64,
+    input::read_capped(path, meta, MAX_MESH_BYTES).map_err(|p| file_error(path, p))
+}
+
+fn file_error(path: &Path, problem: InputProblem) -> ImportError {
+    let path = path.to_owned();
+    match problem {
+        InputProblem::Missing => ImportError::Missing { path },
+        InputProblem::Unreadable(source) => ImportError::Unreadable { path, source },
+        InputProblem::NotRegular(kind) => ImportError::NotRegular { path, kind },
+        InputProblem::TooLarge(size) => ImportError::TooLargeFile {
+            path,
+            size,
             max: MAX_MESH_BYTES,
-        });
+        },
     }
-    Ok(bytes)
 }
 
 /// Reads a mesh from a file's bytes (no file system: what the fuzz tests call).
