@@ -10,7 +10,7 @@ use std::path::Path;
 pub enum InputProblem {
     Missing,
     Unreadable(std::io::Error),
-    /// Not a regular file: a directory, a FIFO…, named as [`crate::io::atomic::kind_of`] does.
+    /// Not a regular file: a directory, a FIFO…, named as the atomic writer names such files.
     NotRegular(&'static str),
     /// More bytes than the cap (at least this many: a growing file is read one byte past it).
     TooLarge(u64),
