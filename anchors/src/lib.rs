@@ -236,9 +236,6 @@ impl StencilTable {
     /// [`StencilTable::apply`] through Far's own `StencilTable::UpdateValues` template (inlined
     /// into the shim) instead of the CPU evaluator.
     pub fn update_values(&self, src: &[[f32; 3]], dst: &mut [[f32; 3]]) -> Result<(), Error> {
-        if !available() {
-            return Err(Error::Unavailable);
-        }
         self.check(src, &[&*dst]);
         // SAFETY: as in apply.
         unsafe {

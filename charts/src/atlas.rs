@@ -299,16 +299,7 @@ impl Atlas {
     /// [`Atlas::locate_unchecked`], with the map from `p`'s chart to each representation's chart (the
     /// identity for `p` itself), for the chain rule. Sorted by chart.
     pub fn locate_with_transitions(&self, p: ChartPoint) -> Vec<(ChartPoint, Lft)> {
-        let i = p.chart.index();
-        let n = self.charts.len();
-        let mut reps = vec![(p, Lft::IDENTITY)];
-        for &(j, k) in self.locators[i].candidates(p.coords) {
-            let t = &self.transitions[i * n + j as usize][k as usize];
-            let w = t.apply(p.coords);
-            if self.charts[j as usize].domain.contains(w) {
-                reps.push((ChartPoint::new(t.to, w), t.lft));
-            }
-        }
+        let mut reps: Vec<(ChartPoint, Lft)> = self.representations(p).collect();
         reps.sort_by_key(|r| r.0.chart);
         reps
     }
@@ -316,18 +307,28 @@ impl Atlas {
     /// [`Atlas::locate_unchecked`]'s representations, written into `out` (cleared first) without
     /// allocating: for loops over many points that reuse one buffer. Sorted by chart.
     pub fn locate_into(&self, p: ChartPoint, out: &mut Vec<ChartPoint>) {
+        out.clear();
+        out.extend(self.representations(p).map(|(rep, _)| rep));
+        out.sort_unstable_by_key(|r| r.chart);
+    }
+
+    /// `p` itself (with the identity), then every other chart's point for it with the transition
+    /// that takes `p`'s chart there; unsorted.
+    fn representations(&self, p: ChartPoint) -> impl Iterator<Item = (ChartPoint, Lft)> + '_ {
         let i = p.chart.index();
         let n = self.charts.len();
-        out.clear();
-        out.push(p);
-        for &(j, k) in self.locators[i].candidates(p.coords) {
-            let t = &self.transitions[i * n + j as usize][k as usize];
-            let w = t.apply(p.coords);
-            if self.charts[j as usize].domain.contains(w) {
-                out.push(ChartPoint::new(t.to, w));
-            }
-        }
-        out.sort_unstable_by_key(|r| r.chart);
+        let others = self.locators[i]
+            .candidates(p.coords)
+            .iter()
+            .filter_map(move |&(j, k)| {
+                let t = &self.transitions[i * n + j as usize][k as usize];
+                let w = t.apply(p.coords);
+                self.charts[j as usize]
+                    .domain
+                    .contains(w)
+                    .then(|| (ChartPoint::new(t.to, w), t.lft))
+            });
+        std::iter::once((p, Lft::IDENTITY)).chain(others)
     }
 
     /// The surface point of a model-space point (any point of the disk, plane, or finite sphere
