@@ -299,8 +299,8 @@ impl Atlas {
     /// [`Atlas::locate_unchecked`], with the map from `p`'s chart to each representation's chart (the
     /// identity for `p` itself), for the chain rule. Sorted by chart.
     pub fn locate_with_transitions(&self, p: ChartPoint) -> Vec<(ChartPoint, Lft)> {
-        let mut reps: Vec<(ChartPoint, Lft)> = self.representations(p).collect();
-        reps.sort_by_key(|r| r.0.chart);
+        let mut reps = Vec::new();
+        self.locate_with_transitions_into(p, &mut reps);
         reps
     }
 
@@ -310,6 +310,13 @@ impl Atlas {
         out.clear();
         out.extend(self.representations(p).map(|(rep, _)| rep));
         out.sort_unstable_by_key(|r| r.chart);
+    }
+
+    /// [`Atlas::locate_with_transitions`], written into `out` (cleared first) without allocating.
+    pub fn locate_with_transitions_into(&self, p: ChartPoint, out: &mut Vec<(ChartPoint, Lft)>) {
+        out.clear();
+        out.extend(self.representations(p));
+        out.sort_unstable_by_key(|r| r.0.chart);
     }
 
     /// `p` itself (with the identity), then every other chart's point for it with the transition

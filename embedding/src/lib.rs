@@ -40,7 +40,7 @@ pub mod surface;
 pub use evaluate::{Curvatures, Sample, SampleSink, Wants, evaluate, evaluate_rows};
 pub use model::{MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader};
 pub use spline_surface::{ControlId, Surface};
-pub use stencil::{ColumnIndex, ControlFrame, Stencil, TensorStencil};
+pub use stencil::{ColumnIndex, ControlFrame, Stencil, TensorStencil, tangent_words};
 pub use surface::{Jet, Layout, Point3, SplineSettings, SurfaceJet, Vector3, Weight, bounding_box};
 
 pub use charts;

@@ -91,7 +91,7 @@ impl Jet {
 
     /// This jet (in coordinates x + iy) seen through a holomorphic map x + iy = ψ(u + iv) with
     /// ψ' = d1 and ψ'' = d2 at the point: the chain rule for a conformal change of variables.
-    fn through(self, d1: Complex64, d2: Complex64) -> Jet {
+    pub(crate) fn through(self, d1: Complex64, d2: Complex64) -> Jet {
         let (xu, yu, xv, yv) = (d1.re, d1.im, -d1.im, d1.re);
         let (xuu, yuu, xuv, yuv, xvv, yvv) = (d2.re, d2.im, -d2.im, d2.re, -d2.re, -d2.im);
         let (fx, fy, fxx, fxy, fyy) = (self.du, self.dv, self.duu, self.duv, self.dvv);
@@ -453,7 +453,7 @@ fn add(acc: &mut Jet, j: Jet) {
 }
 
 /// ψ'(w) and ψ''(w) of an LFT with det 1: 1/(cw + d)² and −2c/(cw + d)³.
-fn derivatives(psi: &Lft, w: Complex64) -> (Complex64, Complex64) {
+pub(crate) fn derivatives(psi: &Lft, w: Complex64) -> (Complex64, Complex64) {
     let [_, _, c, d] = psi.matrix();
     let q = c * w + d;
     let inv = q.inv();

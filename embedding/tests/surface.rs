@@ -672,6 +672,57 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Built with tangents, the tensor stencil gives the f64 stencil's first derivatives S_u, S_v
+    /// (in each row's own chart: blend gradients and transitions' chain rule included) to 1e-5 of
+    /// the largest tangent, and its positions to 1e-6 of the diagonal, for any genus, degree, grid,
+    /// continuity and offset; all cores give the very same numbers.
+    #[test]
+    fn tensor_stencil_tangents_match_the_f64_stencil(
+        genus in prop::sample::select(vec![0u32, 1, 2, 3, 5, 8, 16]),
+        degree in 2usize..=5,
+        grid in 8usize..=20,
+        continuity in 1usize..=3,
+        seed in any::<u64>(),
+        offset in prop::array::uniform3(-1e4f64..1e4),
+        units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..300),
+    ) {
+        let atlas = atlas(genus);
+        let settings = SplineSettings { degree, grid, continuity };
+        let layout = Layout::new(atlas, settings).unwrap();
+        let shift = Vector3::from(offset);
+        let control: Vec<Point3> = noisy_controls(&layout, seed).into_iter().map(|c| c + shift).collect();
+        let mut points: Vec<ChartPoint> = units.iter().map(|&(a, b, c)| chart_point(atlas, a, b, c)).collect();
+        points.extend(atlas.tessellate(3, 2).unwrap().vertices);
+        let exact_stencil = Stencil::build(&layout, &points);
+        let tensor = embedding::TensorStencil::build_with_tangents(&layout, &points);
+        prop_assert!(tensor.has_tangents());
+        let n = points.len();
+        let mut positions = vec![Point3::origin(); n];
+        let mut tangents = vec![[Vector3::zeros(); 2]; n];
+        tensor.positions_and_tangents(&control, &mut positions, &mut tangents);
+        let exact: Vec<(Point3, [Vector3; 2])> =
+            (0..n).map(|r| exact_stencil.position_and_tangents(&control, r)).collect();
+        let exact_positions: Vec<Point3> = exact.iter().map(|e| e.0).collect();
+        let (lo, hi) = embedding::bounding_box(&exact_positions);
+        let diagonal = (hi - lo).norm();
+        let scale = exact.iter().flat_map(|e| e.1).map(|t| t.norm()).fold(0.0, f64::max);
+        for (r, (e, (p, t))) in exact.iter().zip(positions.iter().zip(&tangents)).enumerate() {
+            prop_assert!((p - e.0).norm() <= 1e-6 * diagonal, "row {}: position", r);
+            for k in 0..2 {
+                let off = (t[k] - e.1[k]).norm();
+                prop_assert!(off <= 1e-5 * scale, "row {}: tangent {} off by {:e} of the largest", r, k, off / scale);
+            }
+        }
+        let mut all = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
+        tensor.positions_and_tangents_parallel(&control, &mut all.0, &mut all.1);
+        prop_assert_eq!(&all.0, &positions);
+        prop_assert_eq!(&all.1, &tangents);
+    }
+}
+
 /// Over many parallel tasks (a tessellation of 10⁴ vertices), all cores give the one-thread numbers.
 #[test]
 fn tensor_stencil_gives_the_same_numbers_on_all_cores() {

@@ -1,6 +1,7 @@
 //! Re-embedding on the GPU: [`embedding::TensorStencil`]'s rows applied by a compute shader
 //! (`shaders/reembed.wgsl`), the same sums as the CPU's kernel, in f32 about the control points'
-//! centre. Tested against the CPU on lavapipe (`tests/library/render.rs`).
+//! centre; for a stencil built with tangents, the first derivatives too (for normals). Tested
+//! against the CPU on lavapipe (`tests/library/render.rs`); timed by `ntori bench` where a GPU is.
 
 use embedding::{ControlFrame, Point3, TensorStencil, Vector3};
 use wgpu::util::DeviceExt;
@@ -22,10 +23,18 @@ pub struct GpuReembed {
     readback: wgpu::Buffer,
     rows: u32,
     control_count: usize,
+    /// Position, S_u and S_v per row (else the position alone).
+    tangents: bool,
+}
+
+/// vec4s the shader writes per row.
+fn outputs_per_row(tangents: bool) -> u64 {
+    if tangents { 3 } else { 1 }
 }
 
 impl GpuReembed {
-    /// Uploads `stencil` (for `control_count` control points) to `device`.
+    /// Uploads `stencil` (for `control_count` control points) to `device`. A stencil built with
+    /// tangents gives them too ([`GpuReembed::positions_and_tangents`]).
     pub fn new(
         device: &wgpu::Device,
         stencil: &TensorStencil,
@@ -33,8 +42,9 @@ impl GpuReembed {
     ) -> Result<GpuReembed, RenderError> {
         let limits = device.limits();
         let rows = u32::try_from(stencil.rows()).map_err(|_| too_many(stencil.rows()))?;
-        let blocks = pack_blocks(stencil);
-        let position_bytes = 16 * u64::from(rows.max(1));
+        let tangents = stencil.has_tangents();
+        let (blocks, stride) = pack_blocks(stencil);
+        let position_bytes = 16 * outputs_per_row(tangents) * u64::from(rows.max(1));
         check_buffer(
             &limits,
             "re-embedding stencil",
@@ -54,7 +64,7 @@ impl GpuReembed {
             rows,
             stencil.order() as u32,
             stencil.grid() as u32,
-            1 + 2 * stencil.order() as u32,
+            stride as u32,
         ];
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ntori reembed params"),
@@ -126,7 +136,11 @@ impl GpuReembed {
             label: Some("ntori reembed"),
             layout: Some(&pipeline_layout(device, "ntori reembed", &[&layout])),
             module: &module,
-            entry_point: Some("reembed"),
+            entry_point: Some(if tangents {
+                "reembed_with_tangents"
+            } else {
+                "reembed"
+            }),
             compilation_options: Default::default(),
             cache: None,
         });
@@ -138,11 +152,17 @@ impl GpuReembed {
             readback,
             rows,
             control_count,
+            tangents,
         })
     }
 
     pub fn rows(&self) -> usize {
         self.rows as usize
+    }
+
+    /// Built from a stencil with tangents: [`GpuReembed::positions_and_tangents`] gives them.
+    pub fn has_tangents(&self) -> bool {
+        self.tangents
     }
 
     /// Uploads `control`, applies the stencil on the device and reads the positions back into `out`.
@@ -153,6 +173,48 @@ impl GpuReembed {
         control: &[Point3],
         out: &mut [Point3],
     ) -> Result<(), RenderError> {
+        let centre = self.dispatch(device, queue, control, 1);
+        let per = outputs_per_row(self.tangents) as usize;
+        self.read_back(device, queue, |lanes| {
+            for (o, p) in out.iter_mut().zip(lanes.chunks_exact(per)) {
+                *o = centre + wide(p[0]);
+            }
+        })
+    }
+
+    /// [`GpuReembed::positions`] with the first derivatives S_u, S_v in each row's own chart.
+    ///
+    /// # Panics
+    /// If the stencil was built without tangents.
+    pub fn positions_and_tangents(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        control: &[Point3],
+        positions: &mut [Point3],
+        tangents: &mut [[Vector3; 2]],
+    ) -> Result<(), RenderError> {
+        assert!(self.tangents, "a stencil built with tangents");
+        let centre = self.dispatch(device, queue, control, 1);
+        self.read_back(device, queue, |lanes| {
+            let rows = positions.iter_mut().zip(tangents.iter_mut());
+            for ((p, t), l) in rows.zip(lanes.chunks_exact(3)) {
+                *p = centre + wide(l[0]);
+                *t = [wide(l[1]), wide(l[2])];
+            }
+        })
+    }
+
+    /// Uploads `control` and submits `repeats` applications of the stencil (each the same), then
+    /// waits for the device; the results stay on it. Returns the centre the results are about.
+    /// Repeats are for timing the kernel without the transfers (`ntori bench`).
+    pub fn dispatch(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        control: &[Point3],
+        repeats: u32,
+    ) -> Point3 {
         assert_eq!(
             control.len(),
             self.control_count,
@@ -167,16 +229,29 @@ impl GpuReembed {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.bind_group, &[]);
             let groups = self.rows.div_ceil(GROUP);
-            pass.dispatch_workgroups(groups.min(MAX_GROUPS), groups.div_ceil(MAX_GROUPS), 1);
-        }
-        let bytes = 16 * u64::from(self.rows);
-        if bytes > 0 {
-            encoder.copy_buffer_to_buffer(&self.positions, 0, &self.readback, 0, bytes);
+            for _ in 0..repeats {
+                pass.dispatch_workgroups(groups.min(MAX_GROUPS), groups.div_ceil(MAX_GROUPS), 1);
+            }
         }
         queue.submit([encoder.finish()]);
+        frame.centre
+    }
+
+    /// Waits for the device, copies its results back and hands them to `unpack` as f32 lanes
+    /// ([`outputs_per_row`] vec4s per row).
+    fn read_back(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        unpack: impl FnOnce(&[[f32; 4]]),
+    ) -> Result<(), RenderError> {
+        let bytes = 16 * outputs_per_row(self.tangents) * u64::from(self.rows);
         if bytes == 0 {
             return Ok(());
         }
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.positions, 0, &self.readback, 0, bytes);
+        queue.submit([encoder.finish()]);
         let slice = self.readback.slice(..bytes);
         let (sender, receiver) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -192,30 +267,40 @@ impl GpuReembed {
             .map_err(|e| failed(&e))?;
         {
             let data = slice.get_mapped_range().map_err(|e| failed(&e))?;
-            let lanes: &[[f32; 4]] = bytemuck::cast_slice(&data);
-            for (o, p) in out.iter_mut().zip(lanes) {
-                let d = Vector3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
-                *o = frame.centre + d;
-            }
+            unpack(bytemuck::cast_slice(&data));
         }
         self.readback.unmap();
         Ok(())
     }
 }
 
-/// Each block as u32 words: its first control point, then its factors' f32 bits.
-fn pack_blocks(stencil: &TensorStencil) -> Vec<u32> {
+fn wide(p: [f32; 4]) -> Vector3 {
+    Vector3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
+}
+
+/// Each block as u32 words: its first control point, then its factors' f32 bits, then (built with
+/// tangents) its tangent factors' bits; and the words per block.
+fn pack_blocks(stencil: &TensorStencil) -> (Vec<u32>, usize) {
     let per = 2 * stencil.order();
-    let mut words = Vec::with_capacity(stencil.blocks() * (1 + per));
-    for (first, factors) in stencil
+    let extra = if stencil.blocks() > 0 && stencil.has_tangents() {
+        embedding::tangent_words(stencil.order())
+    } else {
+        0
+    };
+    let stride = 1 + per + extra;
+    let mut words = Vec::with_capacity(stencil.blocks() * stride);
+    for (k, (first, factors)) in stencil
         .firsts()
         .iter()
         .zip(stencil.factors().chunks_exact(per))
+        .enumerate()
     {
         words.push(*first);
         words.extend(factors.iter().map(|f| f.to_bits()));
+        let tangent = &stencil.tangent_factors()[extra * k..extra * (k + 1)];
+        words.extend(tangent.iter().map(|f| f.to_bits()));
     }
-    words
+    (words, stride)
 }
 
 fn padded(words: &[u32]) -> &[u32] {

@@ -208,7 +208,8 @@ fn impossible_requests_are_errors() {
 
 /// The GPU's re-embedding (a compute shader over the tensor stencil) equals the CPU's f64 stencil to
 /// 1e-6 of the bounding-box diagonal, on the example models of genus 0–3 moved far from the origin,
-/// at tessellations of many 64-row workgroups (the last one partly full).
+/// at tessellations of many 64-row workgroups (the last one partly full); built with tangents, its
+/// first derivatives equal the f64 stencil's to 1e-5 of the largest.
 #[test]
 fn gpu_reembedding_equals_the_cpu_to_a_millionth_of_the_diagonal() {
     use embedding::{Point3, Stencil, TensorStencil, Vector3};
@@ -250,5 +251,37 @@ fn gpu_reembedding_equals_the_cpu_to_a_millionth_of_the_diagonal() {
             .collect();
         gpu.positions(&device, &queue, &moved, &mut out).unwrap();
         assert!((out[0] - (exact[0] + Vector3::new(1.0, 2.0, 3.0))).norm() <= 1e-6 * diagonal);
+        // Built with tangents: the first derivatives too, to 1e-5 of the largest.
+        let with_tangents = ntori::render::reembed::GpuReembed::new(
+            &device,
+            &TensorStencil::build_with_tangents(&layout, &points),
+            control.len(),
+        )
+        .unwrap();
+        assert!(with_tangents.has_tangents() && !gpu.has_tangents());
+        let mut tangents = vec![[Vector3::zeros(); 2]; points.len()];
+        with_tangents
+            .positions_and_tangents(&device, &queue, &control, &mut out, &mut tangents)
+            .unwrap();
+        let exact_tangents: Vec<[Vector3; 2]> = (0..points.len())
+            .map(|r| exact_stencil.position_and_tangents(&control, r).1)
+            .collect();
+        let scale = exact_tangents
+            .iter()
+            .flatten()
+            .map(|t| t.norm())
+            .fold(0.0, f64::max);
+        for (r, ((p, t), (e, et))) in out
+            .iter()
+            .zip(&tangents)
+            .zip(exact.iter().zip(&exact_tangents))
+            .enumerate()
+        {
+            assert!((p - e).norm() <= 1e-6 * diagonal, "genus {genus} row {r}");
+            for k in 0..2 {
+                let off = (t[k] - et[k]).norm() / scale;
+                assert!(off <= 1e-5, "genus {genus} row {r}: tangent off by {off:e}");
+            }
+        }
     }
 }

@@ -2,8 +2,8 @@
 //! positions = W · control points, and the same for the first derivatives that normals need.
 //!
 //! [`Stencil`] holds every weight, with its derivatives, in f64: the editor's column updates and
-//! normals use it. [`TensorStencil`] holds positions only, factored chart by chart, in far fewer
-//! bytes: full re-embedding streams it.
+//! normals use it. [`TensorStencil`] holds the same weights factored chart by chart, in far fewer
+//! bytes: positions, and optionally what the first derivatives need; full re-embedding streams it.
 //!
 //! Stored as compressed rows with the weights in separate arrays (structure of arrays), because the
 //! re-embedding loop streams them: a position touches 4 + 8 bytes per weight. A column index (which
@@ -11,7 +11,7 @@
 
 mod tensor;
 
-pub use tensor::{ControlFrame, NEGLIGIBLE_BLEND, TensorStencil};
+pub use tensor::{ControlFrame, NEGLIGIBLE_BLEND, TensorStencil, tangent_words};
 
 use charts::ChartPoint;
 
