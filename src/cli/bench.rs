@@ -29,6 +29,10 @@ pub struct Args {
     #[arg(long, default_value_t = 100_000, value_name = "V",
           value_parser = clap::value_parser!(u64).range(10..=5_000_000))]
     vertices: u64,
+    /// Also time re-embedding on the GPU (the adapter `ntori render` would use): the kernel alone,
+    /// and with the control points' upload and the results' read-back.
+    #[arg(long)]
+    gpu: bool,
     /// No progress messages on stderr.
     #[arg(short, long)]
     quiet: bool,
@@ -38,10 +42,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Args {
         genus: GenusArg { genus },
         vertices,
+        gpu,
         quiet,
     } = args;
     let bar = spinner(quiet);
-    let report = measure(genus, vertices as usize, &|stage| {
+    let report = measure(genus, vertices as usize, gpu, &|stage| {
         bar.set_message(format!("measuring {stage}"));
         bar.tick();
     })?;
@@ -63,6 +68,13 @@ pub struct Figure {
     pub per_baseline_op: f64,
 }
 
+/// How far the GPU's results are from the CPU's.
+#[derive(Debug, Serialize)]
+pub struct GpuAgreement {
+    pub position_of_diagonal: f64,
+    pub tangent_of_largest: f64,
+}
+
 /// The whole report.
 #[derive(Debug, Serialize)]
 pub struct BenchReport {
@@ -71,6 +83,13 @@ pub struct BenchReport {
     /// Baselines, measured in this run.
     pub copy_bandwidth_bytes_per_second: f64,
     pub scalar_ops_per_second: f64,
+    /// The adapter the GPU figures ran on (with `--gpu`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gpu_adapter: Option<String>,
+    /// With `--gpu`: the GPU's positions and tangents against the CPU's tensor stencil, the
+    /// largest differences as fractions of the diagonal and of the largest tangent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gpu_agreement: Option<GpuAgreement>,
     pub figures: Vec<Figure>,
 }
 
@@ -113,6 +132,7 @@ fn scalar_ops() -> f64 {
 pub fn measure(
     genus: u32,
     vertices: usize,
+    gpu: bool,
     progress: &dyn Fn(&str),
 ) -> anyhow::Result<BenchReport> {
     progress("baselines");
@@ -198,6 +218,63 @@ pub fn measure(
         "vertices",
         Some(full_bytes),
     );
+    progress("re-embedding with tangents");
+    let mut framed = TensorStencil::default();
+    let secs = best_of(2, || {
+        framed = TensorStencil::build_with_tangents(&layout, &pts)
+    });
+    add(
+        "stencil_build_tangents",
+        pts.len() as f64 / secs,
+        "vertices",
+        None,
+    );
+    let mut tangents = vec![[Vector3::zeros(); 2]; pts.len()];
+    let bytes = Some(framed.bytes_per_row_with_tangents());
+    let secs = best_of(5, || {
+        framed.positions_and_tangents(black_box(&control), &mut out, &mut tangents)
+    });
+    add(
+        "reembed_tangents",
+        pts.len() as f64 / secs,
+        "vertices",
+        bytes,
+    );
+    let secs = best_of(5, || {
+        framed.positions_and_tangents_parallel(black_box(&control), &mut out, &mut tangents)
+    });
+    add(
+        "reembed_tangents_all_cores",
+        pts.len() as f64 / secs,
+        "vertices",
+        bytes,
+    );
+    let secs = best_of(5, || {
+        for (r, (o, t)) in out.iter_mut().zip(&mut tangents).enumerate() {
+            (*o, *t) = stencil.position_and_tangents(black_box(&control), r);
+        }
+    });
+    let full_bytes = 8.0 + 28.0 * stencil.nonzeros() as f64 / stencil.rows() as f64 + 72.0;
+    add(
+        "reembed_tangents_full_f64",
+        pts.len() as f64 / secs,
+        "vertices",
+        Some(full_bytes),
+    );
+    let (gpu_adapter, gpu_agreement) = if gpu {
+        progress("re-embedding on the GPU");
+        let mut gpu_figures = GpuRun::default();
+        framed.positions_and_tangents_parallel(&control, &mut out, &mut tangents);
+        let cpu = (out.clone(), tangents.clone());
+        let name = gpu_reembedding(&tensor, &framed, &control, &mut gpu_figures)?;
+        for (figure, rate) in gpu_figures.figures {
+            add(figure, rate, "vertices", None);
+        }
+        let agreement = agreement(&cpu, &gpu_figures.frames);
+        (Some(name), Some(agreement))
+    } else {
+        (None, None)
+    };
     progress("drag events");
     let index = stencil.column_index(layout.control_count());
     let mut scratch = RefreshScratch::default();
@@ -218,8 +295,86 @@ pub fn measure(
         vertices: pts.len(),
         copy_bandwidth_bytes_per_second: bandwidth,
         scalar_ops_per_second: scalar,
+        gpu_adapter,
+        gpu_agreement,
         figures,
     })
+}
+
+/// Positions and tangents per row.
+type Frames = (Vec<Point3>, Vec<[Vector3; 2]>);
+
+/// What the GPU measured: figures, and the last round trip's results.
+#[derive(Default)]
+struct GpuRun {
+    figures: Vec<(&'static str, f64)>,
+    frames: Frames,
+}
+
+/// The largest differences between two sets of frames (see [`GpuAgreement`]).
+fn agreement(a: &Frames, b: &Frames) -> GpuAgreement {
+    let (lo, hi) = embedding::bounding_box(&a.0);
+    let diagonal = (hi - lo).norm();
+    let largest = a.1.iter().flatten().map(|t| t.norm()).fold(0.0, f64::max);
+    let worst = |d: &mut dyn Iterator<Item = f64>| d.fold(0.0, f64::max);
+    let position = worst(&mut a.0.iter().zip(&b.0).map(|(p, q)| (p - q).norm()));
+    let tangent = worst(
+        &mut a
+            .1
+            .iter()
+            .flatten()
+            .zip(b.1.iter().flatten())
+            .map(|(p, q)| (p - q).norm()),
+    );
+    GpuAgreement {
+        position_of_diagonal: position / diagonal,
+        tangent_of_largest: tangent / largest,
+    }
+}
+
+/// Rows per second on the GPU for `positions` (positions only) and `framed` (with tangents): the
+/// kernel alone (repeated dispatches, one wait) and, with tangents, the round trip an editor makes
+/// (upload, kernel, read-back). Returns the adapter's name.
+fn gpu_reembedding(
+    positions: &TensorStencil,
+    framed: &TensorStencil,
+    control: &[Point3],
+    run: &mut GpuRun,
+) -> anyhow::Result<String> {
+    let figures = &mut run.figures;
+    use ntori::render::reembed::GpuReembed;
+    let (device, queue, name) = ntori::render::open_device(None)?;
+    let rows = positions.rows() as f64;
+    const REPEATS: u32 = 20;
+    for (figure, stencil) in [("reembed_gpu", positions), ("reembed_gpu_tangents", framed)] {
+        let gpu = GpuReembed::new(&device, stencil, control.len())?;
+        // The first run compiles and warms up.
+        gpu.dispatch(&device, &queue, control, 1);
+        gpu.wait(&device)?;
+        let mut failed = None;
+        let secs = best_of(5, || {
+            gpu.dispatch(&device, &queue, control, REPEATS);
+            failed = gpu.wait(&device).err().or(failed.take());
+        });
+        if let Some(e) = failed {
+            return Err(e.into());
+        }
+        figures.push((figure, rows * f64::from(REPEATS) / secs));
+    }
+    let gpu = GpuReembed::new(&device, framed, control.len())?;
+    let mut out = vec![Point3::origin(); framed.rows()];
+    let mut tangents = vec![[Vector3::zeros(); 2]; framed.rows()];
+    let mut failed = None;
+    let secs = best_of(5, || {
+        let result = gpu.positions_and_tangents(&device, &queue, control, &mut out, &mut tangents);
+        failed = result.err().or(failed.take());
+    });
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
+    figures.push(("reembed_gpu_tangents_round_trip", rows / secs));
+    run.frames = (out, tangents);
+    Ok(name)
 }
 
 /// t_e = t_r = t giving about `vertices` vertices.

@@ -205,9 +205,10 @@ impl GpuReembed {
         })
     }
 
-    /// Uploads `control` and submits `repeats` applications of the stencil (each the same), then
-    /// waits for the device; the results stay on it. Returns the centre the results are about.
-    /// Repeats are for timing the kernel without the transfers (`ntori bench`).
+    /// Uploads `control` and submits `repeats` applications of the stencil (each the same) without
+    /// waiting; the results stay on the device. Returns the centre they are about. Repeats are for
+    /// timing the kernel without the transfers (`ntori bench`, which then waits with
+    /// [`GpuReembed::wait`]).
     pub fn dispatch(
         &self,
         device: &wgpu::Device,
@@ -237,7 +238,15 @@ impl GpuReembed {
         frame.centre
     }
 
-    /// Waits for the device, copies its results back and hands them to `unpack` as f32 lanes
+    /// Waits until the device has done all that was submitted to it.
+    pub fn wait(&self, device: &wgpu::Device) -> Result<(), RenderError> {
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| RenderError::Readback(e.to_string()))
+    }
+
+    /// Copies the device's results back and hands them to `unpack` as f32 lanes
     /// ([`outputs_per_row`] vec4s per row).
     fn read_back(
         &self,
