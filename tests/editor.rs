@@ -480,6 +480,7 @@ fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
         saved_at: 0,
         original: Some(PathBuf::from("/somewhere/sculpture.json")),
         model: model().to_model(),
+        process: None,
     };
     std::fs::write(
         dir.path().join("recovery-4294967288.json"),
@@ -516,6 +517,82 @@ fn a_crash_leaves_a_recovery_file_that_the_next_editor_offers() {
         mine.orphans().is_empty(),
         "a live process's file is not an orphan"
     );
+}
+
+/// A recovery file is not hidden by a process that merely has its writer's id: a zombie (exited,
+/// not reaped) is gone, and so is a live process that started at another time (the id reused);
+/// only the writer itself, or an older file's live namesake, counts as running.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_zombie_or_a_reused_pid_does_not_hide_a_recovery_file() {
+    use ntori::editor::recovery::ProcessStamp;
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, pid: u32, process: Option<ProcessStamp>| {
+        let file = RecoveryFile {
+            format: RECOVERY_FORMAT.into(),
+            pid,
+            saved_at: 0,
+            original: None,
+            model: model().to_model(),
+            process,
+        };
+        let path = dir.path().join(format!("recovery-{name}.json"));
+        std::fs::write(&path, serde_json::to_string(&file).unwrap()).unwrap();
+        path
+    };
+    // A child that exits at once and is not waited for stays a zombie.
+    let mut zombie = Command::new("true").spawn().unwrap();
+    let stat = format!("/proc/{}/stat", zombie.id());
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while !std::fs::read_to_string(&stat)
+        .unwrap()
+        .rsplit(')')
+        .next()
+        .is_some_and(|rest| rest.trim_start().starts_with('Z'))
+    {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the child became a zombie"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let mut sleeper = Command::new("sleep").arg("60").spawn().unwrap();
+    let stamp = ProcessStamp::of(sleeper.id()).expect("/proc tells the stamp");
+    let reused = ProcessStamp {
+        start_ticks: stamp.start_ticks + 1,
+        ..stamp.clone()
+    };
+    let earlier_boot = ProcessStamp {
+        boot: "an-earlier-boot".into(),
+        ..stamp.clone()
+    };
+    let zombie_file = write("zombie", zombie.id(), ProcessStamp::of(zombie.id()));
+    let zombie_old = write("zombie-unstamped", zombie.id(), None);
+    let reused_file = write("reused", sleeper.id(), Some(reused));
+    let rebooted = write("rebooted", sleeper.id(), Some(earlier_boot));
+    write("running", sleeper.id(), Some(stamp));
+    write("running-unstamped", sleeper.id(), None);
+    let mut found: Vec<PathBuf> = Recovery::new(dir.path())
+        .orphans()
+        .into_iter()
+        .map(|o| o.path)
+        .collect();
+    found.sort();
+    let mut expected = vec![zombie_file, zombie_old, reused_file, rebooted];
+    expected.sort();
+    sleeper.kill().unwrap();
+    sleeper.wait().unwrap();
+    zombie.wait().unwrap();
+    assert_eq!(found, expected);
+    // This editor's own autosave records its stamp, and is not an orphan to itself.
+    let mut own = Recovery::new(dir.path());
+    own.autosave(1, || model().to_model(), None, true).unwrap();
+    let text = std::fs::read_to_string(own.own_file()).unwrap();
+    let written: RecoveryFile = serde_json::from_str(&text).unwrap();
+    assert_eq!(written.process, ProcessStamp::current());
+    assert!(written.process.is_some());
+    assert!(!own.orphans().iter().any(|o| o.path == own.own_file()));
 }
 
 /// The real window: `ntori edit` under Xvfb (winit, a wgpu surface on lavapipe), closing itself

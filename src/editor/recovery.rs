@@ -2,6 +2,11 @@
 //! often to `recovery-<pid>.json` in a recovery directory (`$XDG_STATE_HOME/ntori`, or
 //! `~/.local/state/ntori`); a clean exit, or saving, removes the file. A recovery file whose process
 //! is gone is what a crash left, and the next editor offers it.
+//!
+//! "Gone" is decided carefully, since a wrong "still running" hides the work for good: a process
+//! that exited but was not reaped (a zombie) is gone, and so is one whose id now belongs to another
+//! process. The file records its writer's boot and start time ([`ProcessStamp`]); a process with
+//! the same id but another start, or a file from an earlier boot, is not its writer.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -25,6 +30,32 @@ pub struct RecoveryFile {
     /// The document's own file, if it had one.
     pub original: Option<PathBuf>,
     pub model: Model,
+    /// Which run of process `pid` wrote it (absent in files of older versions, and off Linux).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub process: Option<ProcessStamp>,
+}
+
+/// What tells one run of a process from another with the same id: the boot it ran in and when it
+/// started (in clock ticks since that boot, as `/proc/<pid>/stat` gives it).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ProcessStamp {
+    pub boot: String,
+    pub start_ticks: u64,
+}
+
+impl ProcessStamp {
+    /// This process's stamp.
+    pub fn current() -> Option<ProcessStamp> {
+        ProcessStamp::of(std::process::id())
+    }
+
+    /// The stamp of process `pid`, where `/proc` can tell it (Linux).
+    pub fn of(pid: u32) -> Option<ProcessStamp> {
+        Some(ProcessStamp {
+            boot: boot_id()?,
+            start_ticks: proc_stat(pid)?.start_ticks,
+        })
+    }
 }
 
 /// A recovery file left by a process that is gone.
@@ -99,6 +130,7 @@ impl Recovery {
                 .map_or(0, |d| d.as_secs()),
             original: original.map(Path::to_owned),
             model: model(),
+            process: ProcessStamp::current(),
         };
         std::fs::create_dir_all(&self.dir).map_err(|source| FileError::Write {
             path: self.own.clone(),
@@ -132,12 +164,11 @@ impl Recovery {
                 p.file_name()
                     .and_then(|n| n.to_str())
                     .is_some_and(|n| n.starts_with("recovery-") && n.ends_with(".json"))
-                    && *p != self.own
             })
             .filter_map(|path| {
                 let text = std::fs::read_to_string(&path).ok()?;
                 let file: RecoveryFile = serde_json::from_str(&text).ok()?;
-                (file.format == RECOVERY_FORMAT && !alive(file.pid))
+                (file.format == RECOVERY_FORMAT && !written_by_a_live_process(&file))
                     .then_some(Orphan { path, file })
             })
             .collect();
@@ -151,14 +182,50 @@ impl Recovery {
     }
 }
 
-/// Is a process with this id running? (Linux: /proc; elsewhere a file's owner counts as gone.)
-fn alive(pid: u32) -> bool {
-    if pid == std::process::id() {
-        return true;
+/// Is the process that wrote `file` still running? (Elsewhere than Linux only this process
+/// counts as running: a file a crash left there is offered rather than hidden.)
+fn written_by_a_live_process(file: &RecoveryFile) -> bool {
+    let own = std::process::id();
+    if !cfg!(target_os = "linux") {
+        return file.pid == own;
     }
-    if cfg!(target_os = "linux") {
-        Path::new("/proc").join(pid.to_string()).exists()
-    } else {
-        false
+    let Some(stat) = proc_stat(file.pid) else {
+        return false;
+    };
+    // Z: exited, not yet reaped by its parent; X: dead.
+    if matches!(stat.state, 'Z' | 'X' | 'x') {
+        return false;
     }
+    match &file.process {
+        Some(stamp) => {
+            boot_id().as_deref() == Some(stamp.boot.as_str())
+                && stat.start_ticks == stamp.start_ticks
+        }
+        // An older file without a stamp: a running process with its id is taken for its writer.
+        None => true,
+    }
+}
+
+/// The fields of `/proc/<pid>/stat` that tell whether and since when a process runs.
+struct ProcStat {
+    state: char,
+    start_ticks: u64,
+}
+
+fn proc_stat(pid: u32) -> Option<ProcStat> {
+    let text = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may itself hold spaces and ')': the other
+    // fields start after the last ')'. Then field 3 is the state and field 22 the start time.
+    let rest = &text[text.rfind(')')? + 1..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    Some(ProcStat {
+        state: fields.first()?.chars().next()?,
+        start_ticks: fields.get(19)?.parse().ok()?,
+    })
+}
+
+/// This boot's id (it changes on every reboot, when process ids start over).
+fn boot_id() -> Option<String> {
+    let id = std::fs::read_to_string("/proc/sys/kernel/random/boot_id").ok()?;
+    Some(id.trim().to_owned())
 }
