@@ -335,7 +335,9 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
     harness.run();
     let state = harness.state().state().unwrap();
     assert_eq!(state.control(), &before[..], "undo is exact");
-    assert!(!state.is_modified(), "back at the saved state");
+    // Back at the pinned state: the drag is undone, the three pins (changes of their own) stay.
+    assert_eq!(state.pins().len(), 3, "undoing the drag keeps the pins");
+    assert!(state.is_modified(), "the pins are unsaved changes");
     let undone_picture = harness.state().screenshot().unwrap();
     let changed = mid_picture
         .rgba
@@ -397,6 +399,69 @@ fn save_then_open_round_trips_exactly() {
         ntori::io::model_file::load(&path).unwrap().to_model(),
         saved
     );
+}
+
+/// Pins are part of the document: pinning is undoable and marks it modified, pins round-trip
+/// through save and open (as a version 2 model; without pins the file stays version 1, which every
+/// build reads) and survive a change of spline settings.
+#[test]
+fn pins_round_trip_through_undo_save_and_open() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let (k, _) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    let (k2, _) = visible_vertex(harness.state_mut(), [0.4, 0.6]);
+    let dir = tempfile::tempdir().unwrap();
+    let plain = dir.path().join("plain.json");
+    harness.state_mut().save_to(&plain).unwrap();
+    let text = std::fs::read_to_string(&plain).unwrap();
+    assert!(
+        text.contains("\"version\":1") && !text.contains("pins"),
+        "no pins: version 1"
+    );
+    let (a, b) = {
+        let state = harness.state_mut().state_mut().unwrap();
+        let (a, b) = (
+            state.mesh().tessellation.vertices[k],
+            state.mesh().tessellation.vertices[k2],
+        );
+        assert!(!state.is_modified());
+        state.add_pin(a);
+        assert!(state.is_modified(), "pinning changes the document");
+        state.add_pin(b);
+        state.remove_pin(0);
+        assert_eq!(state.pins(), &[b]);
+        state.undo().unwrap();
+        assert_eq!(state.pins(), &[a, b], "undo brings the pin back");
+        state.undo().unwrap();
+        assert_eq!(state.pins(), &[a]);
+        state.redo().unwrap();
+        assert_eq!(state.pins(), &[a, b]);
+        (a, b)
+    };
+    let path = dir.path().join("pinned.json");
+    harness.state_mut().save_to(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("\"version\":2") && text.contains("\"pins\""));
+    harness.state_mut().open(&plain).unwrap();
+    harness.run();
+    assert!(harness.state().state().unwrap().pins().is_empty());
+    harness.state_mut().open(&path).unwrap();
+    harness.run();
+    let state = harness.state_mut().state_mut().unwrap();
+    assert_eq!(state.pins(), &[a, b], "bit for bit");
+    assert!(!state.is_modified());
+    // New spline settings keep the pins (they are surface points).
+    let settings = embedding::SplineSettings {
+        grid: state.settings().grid + 2,
+        ..state.settings()
+    };
+    let (control, _) = ntori::editor::jobs::refit(state.surface(), settings).unwrap();
+    state.set_settings(settings, control).unwrap();
+    assert_eq!(state.pins(), &[a, b]);
+    state.clear_pins();
+    assert!(state.pins().is_empty());
+    state.undo().unwrap();
+    assert_eq!(state.pins(), &[a, b], "clearing is one undo step");
 }
 
 #[test]

@@ -38,7 +38,7 @@ pub mod stencil;
 pub mod surface;
 
 pub use evaluate::{Curvatures, Sample, SampleSink, Wants, evaluate, evaluate_rows};
-pub use model::{MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader};
+pub use model::{MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader, ModelPin, PINS_VERSION};
 pub use spline_surface::{ControlId, Surface};
 pub use stencil::{ColumnIndex, ControlFrame, Stencil, TensorStencil, tangent_words};
 pub use surface::{Jet, Layout, Point3, SplineSettings, SurfaceJet, Vector3, Weight, bounding_box};
@@ -70,6 +70,8 @@ pub enum EmbeddingError {
         "control point {index} has a coordinate of {value:e}, beyond the ±{max:e} a model may hold"
     )]
     OutOfRange { index: usize, value: f64, max: f64 },
+    #[error("pin {index} {problem}")]
+    BadPin { index: usize, problem: String },
     #[error("constraint {0} asks for a position that is not a finite point")]
     BadTarget(usize),
     #[error("the edit's constraints could not be solved")]

@@ -7,7 +7,21 @@ use crate::surface::{Layout, Point3, SplineSettings};
 
 /// The file format's name, and the newest version this build reads and writes.
 pub const MODEL_FORMAT: &str = "ntori-model";
-pub const MODEL_VERSION: u32 = 1;
+pub const MODEL_VERSION: u32 = 2;
+
+/// The first version that holds pins. A model without pins is written as version 1, which every
+/// build reads; one with pins as version 2.
+pub const PINS_VERSION: u32 = 2;
+
+/// A pinned surface point: a chart and coordinates in it (the editor holds pins in place while
+/// dragging). Part of the model since version 2.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelPin {
+    pub chart: u32,
+    /// The point's coordinates in the chart (real and imaginary parts).
+    pub at: [f64; 2],
+}
 
 /// The largest magnitude a control point coordinate may have in a model. Fitted models are a few
 /// units across; 10⁹ leaves room for any sensible scale while keeping every product the
@@ -26,6 +40,9 @@ pub struct Model {
     pub genus: u32,
     pub settings: SplineSettings,
     pub control_points: Vec<[f64; 3]>,
+    /// Pinned surface points (version 2 on; absent when there are none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pins: Vec<ModelPin>,
 }
 
 /// The first fields of any model file, whatever its version: read these first, then the rest.
@@ -56,10 +73,12 @@ impl Model {
     pub fn constant(layout: &Layout, point: Point3) -> Model {
         Model {
             format: MODEL_FORMAT.into(),
-            version: MODEL_VERSION,
+            // Without pins, the version every build reads.
+            version: 1,
             genus: layout.atlas().genus(),
             settings: layout.settings(),
             control_points: vec![[point.x, point.y, point.z]; layout.control_count()],
+            pins: Vec::new(),
         }
     }
 

@@ -12,7 +12,7 @@ use charts::{Atlas, ChartPoint, Lft};
 
 use crate::EmbeddingError;
 use crate::bspline::UniformBasis;
-use crate::model::{Model, ModelHeader};
+use crate::model::{Model, ModelHeader, ModelPin, PINS_VERSION};
 use crate::surface::{Layout, Point3, SplineSettings, SurfaceJet};
 
 /// A control point's index in [`Layout`] order (chart-major, then row-major in the chart's grid).
@@ -25,14 +25,16 @@ impl ControlId {
     }
 }
 
-/// An owned, validated surface (see the module documentation). Two surfaces are equal when their
-/// genus, settings and control points are.
+/// An owned, validated surface (see the module documentation), with its pins. Two surfaces are equal
+/// when their genus, settings, control points and pins are.
 #[derive(Clone, Debug)]
 pub struct Surface {
     atlas: Arc<Atlas>,
     settings: SplineSettings,
     basis: UniformBasis,
     control: Vec<Point3>,
+    /// Surface points the editor holds in place (each inside its chart's domain).
+    pins: Vec<ChartPoint>,
 }
 
 impl PartialEq for Surface {
@@ -40,6 +42,7 @@ impl PartialEq for Surface {
         self.genus() == other.genus()
             && self.settings == other.settings
             && self.control == other.control
+            && self.pins == other.pins
     }
 }
 
@@ -57,6 +60,7 @@ impl Surface {
             settings,
             basis,
             control: Vec::new(),
+            pins: Vec::new(),
         };
         surface.check_points(&control)?;
         Ok(Surface { control, ..surface })
@@ -70,13 +74,86 @@ impl Surface {
             version: model.version,
         }
         .check()?;
+        if !model.pins.is_empty() && model.version < PINS_VERSION {
+            return Err(EmbeddingError::BadPin {
+                index: 0,
+                problem: format!(
+                    "is in a version {} model; pins need version {PINS_VERSION}",
+                    model.version
+                ),
+            });
+        }
         let atlas = Arc::new(Atlas::new(model.genus)?);
-        Surface::new(atlas, model.settings, model.points())
+        let pins = model
+            .pins
+            .iter()
+            .enumerate()
+            .map(|(index, pin)| {
+                let chart = Some(pin.chart)
+                    .filter(|&c| (c as usize) < atlas.charts().len())
+                    .ok_or_else(|| EmbeddingError::BadPin {
+                        index,
+                        problem: format!(
+                            "names chart {}; this genus has charts 0 to {}",
+                            pin.chart,
+                            atlas.charts().len() - 1
+                        ),
+                    })?;
+                Ok(ChartPoint::new(
+                    charts::ChartId(chart),
+                    num_complex::Complex64::new(pin.at[0], pin.at[1]),
+                ))
+            })
+            .collect::<Result<Vec<_>, EmbeddingError>>()?;
+        let mut surface = Surface::new(atlas, model.settings, model.points())?;
+        surface.set_pins(pins)?;
+        Ok(surface)
     }
 
-    /// The model document of this surface (current format and version).
+    /// The model document of this surface: version 1 without pins (every build reads it), else
+    /// [`PINS_VERSION`].
     pub fn to_model(&self) -> Model {
-        Model::from_points(&self.layout(), &self.control)
+        let mut model = Model::from_points(&self.layout(), &self.control);
+        if !self.pins.is_empty() {
+            model.version = PINS_VERSION;
+            model.pins = self
+                .pins
+                .iter()
+                .map(|p| ModelPin {
+                    chart: p.chart.0,
+                    at: [p.coords.re, p.coords.im],
+                })
+                .collect();
+        }
+        model
+    }
+
+    /// The pinned surface points.
+    pub fn pins(&self) -> &[ChartPoint] {
+        &self.pins
+    }
+
+    /// Replaces the pins; each must lie in its chart's domain, with finite coordinates (on error
+    /// nothing changes).
+    pub fn set_pins(&mut self, pins: Vec<ChartPoint>) -> Result<(), EmbeddingError> {
+        for (index, p) in pins.iter().enumerate() {
+            let bad = |problem: String| EmbeddingError::BadPin { index, problem };
+            let chart =
+                self.atlas.charts().get(p.chart.index()).ok_or_else(|| {
+                    bad(format!("names chart {}, which does not exist", p.chart.0))
+                })?;
+            if !(p.coords.re.is_finite() && p.coords.im.is_finite()) {
+                return Err(bad("has a coordinate that is not a finite number".into()));
+            }
+            if !chart.domain().contains(p.coords) {
+                return Err(bad(format!(
+                    "at ({}, {}) lies outside chart {}'s domain",
+                    p.coords.re, p.coords.im, p.chart.0
+                )));
+            }
+        }
+        self.pins = pins;
+        Ok(())
     }
 
     /// The same atlas and settings with other control points (checked like [`Surface::new`]).
@@ -87,6 +164,7 @@ impl Surface {
             settings: self.settings,
             basis: self.basis,
             control,
+            pins: self.pins.clone(),
         })
     }
 

@@ -1,6 +1,8 @@
 //! Undo and redo. A drag stores only the control points it moved, before and after (exact copies, so
-//! undo restores them bit for bit); a change of spline settings stores both whole models.
+//! undo restores them bit for bit); a change of spline settings stores both whole models, a change of
+//! pins both lists.
 
+use embedding::charts::ChartPoint;
 use embedding::{ControlId, Point3, SplineSettings};
 
 /// One undoable change.
@@ -17,6 +19,11 @@ pub enum Change {
         before: (SplineSettings, Vec<Point3>),
         after: (SplineSettings, Vec<Point3>),
     },
+    /// Pins were added or removed.
+    Pins {
+        before: Vec<ChartPoint>,
+        after: Vec<ChartPoint>,
+    },
 }
 
 impl Change {
@@ -24,6 +31,7 @@ impl Change {
         match self {
             Change::Controls { indices, .. } => indices.len() * (4 + 48),
             Change::Settings { before, after } => (before.1.len() + after.1.len()) * 24,
+            Change::Pins { before, after } => (before.len() + after.len()) * 24,
         }
     }
 }

@@ -68,7 +68,6 @@ pub struct EditorState {
     pub camera: OrbitCamera,
     /// The viewport's size in physical pixels.
     pub viewport: [f64; 2],
-    pins: Vec<ChartPoint>,
     drag: Option<Drag>,
     history: History,
     path: Option<PathBuf>,
@@ -92,7 +91,6 @@ impl EditorState {
             surface,
             mesh,
             meshing,
-            pins: Vec::new(),
             drag: None,
             history: History::new(),
             path: None,
@@ -170,8 +168,9 @@ impl EditorState {
     pub fn mark_modified(&mut self) {
         self.saved_state = u64::MAX;
     }
+    /// The pinned surface points (the document's: saved with it, and part of undo).
     pub fn pins(&self) -> &[ChartPoint] {
-        &self.pins
+        self.surface.pins()
     }
     pub fn drag(&self) -> Option<&Drag> {
         self.drag.as_ref()
@@ -252,7 +251,7 @@ impl EditorState {
 
     /// The pin drawn within `radius` pixels of `pixel` (nearest first), if any.
     pub fn pin_near(&self, pixel: [f64; 2], radius: f64) -> Option<usize> {
-        self.pins
+        self.pins()
             .iter()
             .enumerate()
             .map(|(i, &p)| {
@@ -268,28 +267,45 @@ impl EditorState {
     /// changed.
     pub fn toggle_pin(&mut self, pixel: [f64; 2]) -> bool {
         if let Some(i) = self.pin_near(pixel, PIN_RADIUS_PX) {
-            self.pins.remove(i);
+            self.remove_pin(i);
             return true;
         }
         match self.pick(pixel) {
             Some(pick) => {
-                self.pins.push(pick.point);
+                self.add_pin(pick.point);
                 true
             }
             None => false,
         }
     }
 
+    /// Pins `point` (an undoable change).
     pub fn add_pin(&mut self, point: ChartPoint) {
-        self.pins.push(point);
+        let mut pins = self.pins().to_vec();
+        pins.push(point);
+        self.change_pins("pin", pins);
     }
+    /// Removes pin `i` (an undoable change).
     pub fn remove_pin(&mut self, i: usize) {
-        if i < self.pins.len() {
-            self.pins.remove(i);
+        if i < self.pins().len() {
+            let mut pins = self.pins().to_vec();
+            pins.remove(i);
+            self.change_pins("unpin", pins);
         }
     }
+    /// Removes every pin (one undoable change).
     pub fn clear_pins(&mut self) {
-        self.pins.clear();
+        if !self.pins().is_empty() {
+            self.change_pins("clear pins", Vec::new());
+        }
+    }
+
+    fn change_pins(&mut self, label: &str, after: Vec<ChartPoint>) {
+        let before = self.pins().to_vec();
+        // Picked points lie in their charts, and removing pins keeps the rest valid.
+        if self.surface.set_pins(after.clone()).is_ok() {
+            self.history.push(label, Change::Pins { before, after });
+        }
     }
 
     // ------------------------------------------------------------------------------- dragging
@@ -301,7 +317,7 @@ impl EditorState {
             return Ok(None);
         }
         let (point, grab) = if let Some(i) = self.pin_near(pixel, PIN_RADIUS_PX) {
-            (self.pins[i], Grab::Pin(i))
+            (self.pins()[i], Grab::Pin(i))
         } else if let Some(pick) = self.pick(pixel) {
             (pick.point, Grab::Surface)
         } else {
@@ -319,7 +335,7 @@ impl EditorState {
         pixel: [f64; 2],
     ) -> Result<(), EditorError> {
         let pins: Vec<ChartPoint> = self
-            .pins
+            .pins()
             .iter()
             .enumerate()
             .filter(|&(i, _)| grab != Grab::Pin(i))
@@ -498,6 +514,10 @@ impl EditorState {
                 let (settings, control) = if forward { after } else { before };
                 self.replace_control(*settings, control.clone())?;
             }
+            Change::Pins { before, after } => {
+                let pins = if forward { after } else { before };
+                self.surface.set_pins(pins.clone())?;
+            }
         }
         Ok(())
     }
@@ -528,7 +548,9 @@ impl EditorState {
         settings: SplineSettings,
         control: Vec<Point3>,
     ) -> Result<(), EditorError> {
-        let surface = Surface::new(self.surface.shared_atlas(), settings, control)?;
+        let mut surface = Surface::new(self.surface.shared_atlas(), settings, control)?;
+        // Pins are surface points, whatever the spline settings.
+        surface.set_pins(self.pins().to_vec())?;
         let mesh = LiveMesh::new(&surface, self.meshing, self.mesh.style())?;
         self.surface = surface;
         self.mesh = mesh;

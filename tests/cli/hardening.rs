@@ -614,6 +614,26 @@ fn bad_input_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
             edit("future.json", &|v| v["version"] = 99.into()),
         ),
         (
+            "PIN_CHART".into(),
+            edit("pin-chart.json", &|v| {
+                v["version"] = 2.into();
+                v["pins"] = serde_json::json!([{"chart": 0, "at": [0.0, 0.0]}, {"chart": 4000, "at": [0.0, 0.0]}]);
+            }),
+        ),
+        (
+            "PIN_OUTSIDE".into(),
+            edit("pin-outside.json", &|v| {
+                v["version"] = 2.into();
+                v["pins"] = serde_json::json!([{"chart": 0, "at": [7.0, 0.0]}]);
+            }),
+        ),
+        (
+            "PIN_VERSION1".into(),
+            edit("pin-version1.json", &|v| {
+                v["pins"] = serde_json::json!([{"chart": 0, "at": [0.0, 0.0]}]);
+            }),
+        ),
+        (
             "LONG_STRING".into(),
             edit("long.json", &|v| v["genus"] = "y".repeat(1_000_000).into()),
         ),
