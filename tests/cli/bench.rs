@@ -21,19 +21,55 @@ fn bench_prints_json_figures() {
             "reembed",
             "reembed_all_cores",
             "reembed_full_f64",
+            "stencil_build_tangents",
+            "reembed_tangents",
+            "reembed_tangents_all_cores",
+            "reembed_tangents_full_f64",
             "drag_event"
         ]
+    );
+    assert!(
+        v.get("gpu_adapter").is_none(),
+        "no GPU figures unless asked"
     );
     for f in figures {
         let rate = f["per_second"].as_f64().unwrap();
         assert!(rate.is_finite() && rate > 0.0, "{f}");
     }
-    for f in &figures[4..7] {
+    for f in figures[4..7].iter().chain(&figures[8..11]) {
         let fraction = f["fraction_of_copy_bandwidth"].as_f64().unwrap();
         assert!(
             fraction > 0.0 && fraction < 5.0,
             "re-embedding cannot beat memory by much: {f}"
         );
+    }
+}
+
+/// With `--gpu` (lavapipe in CI): the GPU's figures, its adapter, and its results against the CPU's.
+#[test]
+fn bench_on_the_gpu_agrees_with_the_cpu() {
+    let v = ntori_json(&["bench", "--quiet", "--vertices", "3000", "--gpu"]);
+    assert!(!v["gpu_adapter"].as_str().unwrap().is_empty());
+    let agreement = &v["gpu_agreement"];
+    assert!(agreement["position_of_diagonal"].as_f64().unwrap() <= 1e-6);
+    assert!(agreement["tangent_of_largest"].as_f64().unwrap() <= 1e-5);
+    let gpu: Vec<&serde_json::Value> = v["figures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["name"].as_str().unwrap().contains("gpu"))
+        .collect();
+    let names: Vec<&str> = gpu.iter().map(|f| f["name"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        [
+            "reembed_gpu",
+            "reembed_gpu_tangents",
+            "reembed_gpu_tangents_round_trip"
+        ]
+    );
+    for f in gpu {
+        assert!(f["per_second"].as_f64().unwrap() > 0.0, "{f}");
     }
 }
 
