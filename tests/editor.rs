@@ -812,9 +812,107 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
         before.to_model(),
         "undo restores settings and control points"
     );
+    // The panel shows the settings the surface has again: nothing to apply.
+    let grid = |harness: &Harness<'static, EditorApp>| {
+        use egui_kittest::kittest::NodeT as _;
+        let node = harness.get_by_label("Grid per chart");
+        node.accesskit_node().numeric_value()
+    };
+    assert_eq!(
+        grid(&harness),
+        Some(16.0),
+        "the grid field follows the undo"
+    );
+    assert!(harness.state().state().unwrap().settings().grid == 16);
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     harness.run();
     assert_eq!(harness.state().state().unwrap().settings().grid, 12);
+    assert_eq!(grid(&harness), Some(12.0), "and the redo");
+}
+
+/// Input is not lost however fast it comes: three Ctrl + Z in one frame undo three steps, a
+/// Ctrl + Shift + Z between them redoes in its turn, and a Ctrl + click whose Ctrl is let go within
+/// the same frame still pins.
+#[test]
+fn every_key_and_click_of_a_frame_counts_in_order() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let points: Vec<ChartPoint> = (0..4)
+        .map(|k| {
+            harness
+                .state()
+                .state()
+                .unwrap()
+                .mesh()
+                .tessellation
+                .vertices[40 * k + 7]
+        })
+        .collect();
+    {
+        let state = harness.state_mut().state_mut().unwrap();
+        for &p in &points {
+            state.add_pin(p);
+        }
+    }
+    let key = |key, modifiers| Event::Key {
+        key,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers,
+    };
+    // kittest's `event` gives each queued event a frame of its own: these go into one frame's
+    // input instead.
+    let mut one_frame = Vec::new();
+    for _ in 0..3 {
+        one_frame.push(key(Key::Z, Modifiers::COMMAND));
+    }
+    in_one_frame(&mut harness, &mut one_frame);
+    assert_eq!(
+        harness.state().state().unwrap().pins(),
+        &points[..1],
+        "three undos"
+    );
+    // Undo, redo, redo, undo in one frame: in order, one pin more at the end than at the start.
+    for (k, m) in [
+        (Key::Z, Modifiers::COMMAND),
+        (Key::Z, Modifiers::COMMAND | Modifiers::SHIFT),
+        (Key::Y, Modifiers::COMMAND),
+        (Key::Z, Modifiers::COMMAND),
+        (Key::Y, Modifiers::COMMAND),
+    ] {
+        one_frame.push(key(k, m));
+    }
+    in_one_frame(&mut harness, &mut one_frame);
+    assert_eq!(harness.state().state().unwrap().pins(), &points[..2]);
+    // A quick Ctrl + click: Ctrl down, press, release and Ctrl up all within one frame.
+    let (_, pixel) = visible_vertex(harness.state_mut(), [0.45, 0.55]);
+    let pos = pos_of(harness.state(), pixel);
+    harness.event(Event::PointerMoved(pos));
+    harness.step();
+    one_frame.push(Event::ModifiersChanged(Modifiers::COMMAND));
+    for pressed in [true, false] {
+        one_frame.push(Event::PointerButton {
+            pos,
+            button: PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::COMMAND,
+        });
+    }
+    one_frame.push(Event::ModifiersChanged(Modifiers::NONE));
+    in_one_frame(&mut harness, &mut one_frame);
+    assert_eq!(
+        harness.state().state().unwrap().pins().len(),
+        3,
+        "the quick Ctrl + click pinned"
+    );
+}
+
+/// Runs one frame with all of `events` in its input, then until the app settles.
+fn in_one_frame(harness: &mut Harness<'static, EditorApp>, events: &mut Vec<Event>) {
+    harness.input_mut().events.append(events);
+    harness.step();
+    harness.run();
 }
 
 /// The side panel's tessellation: the quality one by default, t_e/t_r at the press of a radio

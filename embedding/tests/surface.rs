@@ -711,8 +711,8 @@ proptest! {
         let scale = exact.iter().flat_map(|e| e.1).map(|t| t.norm()).fold(0.0, f64::max);
         for (r, (e, (p, t))) in exact.iter().zip(positions.iter().zip(&tangents)).enumerate() {
             prop_assert!((p - e.0).norm() <= 1e-6 * diagonal, "row {}: position", r);
-            for k in 0..2 {
-                let off = (t[k] - e.1[k]).norm();
+            for (k, (a, b)) in t.iter().zip(&e.1).enumerate() {
+                let off = (a - b).norm();
                 prop_assert!(off <= 1e-5 * scale, "row {}: tangent {} off by {:e} of the largest", r, k, off / scale);
             }
         }

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use charts::ChartId;
-use egui::{Context, Key, KeyboardShortcut, Modifiers};
+use egui::{Context, Key, Modifiers};
 use embedding::SplineSettings;
 
 use super::app::EditorApp;
@@ -132,7 +132,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Ctrl + Q", "quit"),
 ];
 
-/// The keyboard's commands this frame. `new_model` is what the new-model dialog starts with; the
+/// The keyboard's commands this frame, one per key press and in the order pressed (three quick
+/// Ctrl + Z in one frame undo three steps). `new_model` is what the new-model dialog starts with; the
 /// view's keys need a model.
 pub fn shortcuts(
     ctx: &Context,
@@ -141,71 +142,103 @@ pub fn shortcuts(
     new_model: (u32, SplineSettings),
     commands: &mut Vec<Command>,
 ) {
-    let consume = |modifiers, key| {
-        ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(modifiers, key)))
+    let typing = ctx.egui_wants_keyboard_input();
+    let context = KeyContext {
+        busy,
+        has_model,
+        typing,
+        new_model,
     };
-    let command = |key| consume(Modifiers::COMMAND, key);
-    // The shifted forms first: Ctrl + Z also matches Ctrl + Shift + Z.
-    if consume(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z) || command(Key::Y) {
-        commands.push(Command::Redo);
-    }
-    if command(Key::Z) {
-        commands.push(Command::Undo);
-    }
-    if consume(Modifiers::COMMAND | Modifiers::SHIFT, Key::S) && !busy {
-        commands.push(Command::AskFile(FileAction::SaveAs, None));
-    }
-    if command(Key::S) && !busy {
-        commands.push(Command::Save(None));
-    }
-    if command(Key::O) && !busy {
-        commands.push(Command::Guarded(Pending::Open(None)));
-    }
-    if command(Key::N) && !busy {
-        commands.push(Command::NewModelDialog(new_model.0, new_model.1));
-    }
-    if command(Key::E) && !busy {
-        commands.push(Command::AskFile(FileAction::Export, None));
-    }
-    if command(Key::Q) {
-        commands.push(Command::Quit);
-    }
-    let plain = |key| consume(Modifiers::NONE, key);
-    if plain(Key::F12) {
-        commands.push(Command::AskFile(FileAction::Screenshot, None));
-    }
-    if plain(Key::F1) {
-        commands.push(Command::ToggleHelp);
-    }
-    if ctx.egui_wants_keyboard_input() {
-        return;
-    }
-    if plain(Key::Escape) {
-        commands.push(Command::Escape);
-    }
-    if !has_model {
-        return;
-    }
-    let keys = [
-        (Key::F, Command::Frame),
-        (Key::Home, Command::ResetView),
-        (Key::Num1, Command::SetStyle(Style::Shaded)),
-        (Key::Num2, Command::SetStyle(Style::Wireframe)),
-        (Key::Num3, Command::SetStyle(Style::Charts)),
-        (
-            Key::Num4,
-            Command::SetStyle(Style::Curvature(CurvatureKind::Gaussian)),
-        ),
-        (
-            Key::Num5,
-            Command::SetStyle(Style::Curvature(CurvatureKind::Mean)),
-        ),
-        (Key::C, Command::NextControlNet),
-    ];
-    for (key, command) in keys {
-        if plain(key) {
-            commands.push(command);
+    ctx.input_mut(|i| {
+        i.events.retain(|event| {
+            let egui::Event::Key {
+                key,
+                pressed: true,
+                modifiers,
+                ..
+            } = event
+            else {
+                return true;
+            };
+            match context.action(*key, *modifiers) {
+                KeyAction::Run(command) => {
+                    commands.push(command);
+                    false
+                }
+                KeyAction::Swallow => false,
+                KeyAction::Pass => true,
+            }
+        })
+    });
+}
+
+/// What decides a key's meaning besides the key.
+struct KeyContext {
+    busy: bool,
+    has_model: bool,
+    /// A text field has the keyboard: plain keys are its.
+    typing: bool,
+    new_model: (u32, SplineSettings),
+}
+
+/// What one key press does.
+enum KeyAction {
+    Run(Command),
+    /// A shortcut that cannot act now (a file action while a job runs): used up all the same.
+    Swallow,
+    /// Not ours: left for the widgets.
+    Pass,
+}
+
+impl KeyContext {
+    fn action(&self, key: Key, m: Modifiers) -> KeyAction {
+        let run = KeyAction::Run;
+        let unless_busy = |command| {
+            if self.busy {
+                KeyAction::Swallow
+            } else {
+                KeyAction::Run(command)
+            }
+        };
+        if m.command {
+            // As egui's shortcuts match: extra Shift or Alt does not stop a shortcut without them.
+            return match (key, m.shift) {
+                (Key::Z, true) | (Key::Y, _) => run(Command::Redo),
+                (Key::Z, false) => run(Command::Undo),
+                (Key::S, true) => unless_busy(Command::AskFile(FileAction::SaveAs, None)),
+                (Key::S, false) => unless_busy(Command::Save(None)),
+                (Key::O, _) => unless_busy(Command::Guarded(Pending::Open(None))),
+                (Key::N, _) => {
+                    unless_busy(Command::NewModelDialog(self.new_model.0, self.new_model.1))
+                }
+                (Key::E, _) => unless_busy(Command::AskFile(FileAction::Export, None)),
+                (Key::Q, _) => run(Command::Quit),
+                _ => KeyAction::Pass,
+            };
         }
+        if m.ctrl {
+            return KeyAction::Pass;
+        }
+        match key {
+            Key::F12 => return run(Command::AskFile(FileAction::Screenshot, None)),
+            Key::F1 => return run(Command::ToggleHelp),
+            _ if self.typing => return KeyAction::Pass,
+            Key::Escape => return run(Command::Escape),
+            _ if !self.has_model => return KeyAction::Pass,
+            _ => {}
+        }
+        let command = match key {
+            Key::F => Command::Frame,
+            Key::Home => Command::ResetView,
+            Key::Num1 => Command::SetStyle(Style::Shaded),
+            Key::Num2 => Command::SetStyle(Style::Wireframe),
+            Key::Num3 => Command::SetStyle(Style::Charts),
+            Key::Num4 => Command::SetStyle(Style::Curvature(CurvatureKind::Gaussian)),
+            Key::Num5 => Command::SetStyle(Style::Curvature(CurvatureKind::Mean)),
+            Key::C => Command::NextControlNet,
+            _ => return KeyAction::Pass,
+        };
+        run(command)
     }
 }
 
@@ -351,11 +384,16 @@ impl EditorApp {
     /// Undoes (or redoes) the last change, saying which.
     fn undo_redo(&mut self, redo: bool) {
         let Some(state) = &mut self.state else { return };
+        let settings = state.settings();
         let (result, done, verb) = if redo {
             (state.redo(), "redid", "redo")
         } else {
             (state.undo(), "undid", "undo")
         };
+        // The panel shows the settings the surface now has (an undone refit takes its own back).
+        if state.settings() != settings {
+            self.panel.settings_applied(state.settings());
+        }
         match result {
             Ok(Some(label)) => self.messages.info(format!("{done} {label}")),
             Ok(None) => {}

@@ -35,6 +35,9 @@ pub struct Viewport {
     hover: Option<Pick>,
     selected: Option<Pick>,
     rect: Rect,
+    /// The modifiers held when the primary button last went down: a click or drag is read with
+    /// them, so a quick Ctrl + click (Ctrl up again within the frame) still pins.
+    press_modifiers: egui::Modifiers,
 }
 
 impl Viewport {
@@ -45,6 +48,7 @@ impl Viewport {
             texture: None,
             last_drawn: None,
             interaction: Interaction::None,
+            press_modifiers: egui::Modifiers::NONE,
             hover: None,
             selected: None,
             rect: Rect::from_min_size(Pos2::ZERO, Vec2::new(800.0, 600.0)),
@@ -138,7 +142,10 @@ impl Viewport {
         messages: &mut Messages,
     ) {
         let ppp = ctx.pixels_per_point();
-        let modifiers = ctx.input(|i| i.modifiers);
+        if let Some(m) = ctx.input(|i| primary_press_modifiers(&i.events)) {
+            self.press_modifiers = m;
+        }
+        let modifiers = self.press_modifiers;
         if response.drag_started() {
             let origin = ctx
                 .input(|i| i.pointer.press_origin())
@@ -461,6 +468,19 @@ enum Wheel {
 
 /// A mouse wheel zooms; two fingers on a trackpad orbit (with Shift: pan); pinching, or the wheel
 /// with Ctrl, zooms through egui's zoom delta (left out here).
+/// The modifiers of this frame's last press of the primary button, if any.
+fn primary_press_modifiers(events: &[egui::Event]) -> Option<egui::Modifiers> {
+    events.iter().rev().find_map(|e| match e {
+        egui::Event::PointerButton {
+            button: PointerButton::Primary,
+            pressed: true,
+            modifiers,
+            ..
+        } => Some(*modifiers),
+        _ => None,
+    })
+}
+
 fn wheel_gestures(events: &[egui::Event]) -> Vec<Wheel> {
     use egui::{MouseWheelSource, MouseWheelUnit};
     events

@@ -278,8 +278,8 @@ fn gpu_reembedding_equals_the_cpu_to_a_millionth_of_the_diagonal() {
             .enumerate()
         {
             assert!((p - e).norm() <= 1e-6 * diagonal, "genus {genus} row {r}");
-            for k in 0..2 {
-                let off = (t[k] - et[k]).norm() / scale;
+            for (a, b) in t.iter().zip(et) {
+                let off = (a - b).norm() / scale;
                 assert!(off <= 1e-5, "genus {genus} row {r}: tangent off by {off:e}");
             }
         }
