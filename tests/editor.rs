@@ -1070,6 +1070,65 @@ fn the_influence_radius_widens_the_edit_and_keeps_the_constraints() {
     assert!(moved[1] > 2 * moved[0], "control points moved: {moved:?}");
 }
 
+/// With an influence radius the drag is a brush defined on the surface: the same surface point
+/// picked in two charts gives the same edit (to 1e-9 of the model's size), for every falloff
+/// profile, and the dragged point reaches its target.
+#[test]
+fn a_brush_edit_does_not_depend_on_the_chart_it_was_picked_in() {
+    use embedding::brush::Falloff;
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let state = harness.state_mut().state_mut().unwrap();
+    let size = state.size();
+    // A vertex in an overlap, with its point in another chart.
+    let (point, other) = state
+        .mesh()
+        .tessellation
+        .vertices
+        .iter()
+        .step_by(7)
+        .find_map(|&p| {
+            let reps = state.atlas().locate(p).ok()?;
+            let other = *reps.representations().iter().find(|q| q.chart != p.chart)?;
+            Some((p, other))
+        })
+        .expect("a vertex in two charts");
+    state.influence = 0.25;
+    for falloff in [
+        Falloff::Smooth,
+        Falloff::Dome,
+        Falloff::Sharp,
+        Falloff::Constant,
+    ] {
+        state.falloff = falloff;
+        let before = state.control().to_vec();
+        let target = state.surface_point(point) + Vector3::new(0.03, -0.02, 0.06) * size;
+        let mut edits = Vec::new();
+        for picked in [point, other] {
+            state.start_drag(picked, Grab::Surface, [0.0, 0.0]).unwrap();
+            state.drag_to_target(target).unwrap();
+            assert!((state.surface_point(picked) - target).norm() < 1e-6 * size);
+            edits.push(state.control().to_vec());
+            state.cancel_drag();
+            assert_eq!(state.control(), &before[..]);
+        }
+        let worst = edits[0]
+            .iter()
+            .zip(&edits[1])
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        assert!(
+            worst <= 1e-9 * size,
+            "{falloff:?}: the edits differ by {worst:e}"
+        );
+        let moved = edits[0].iter().zip(&before).filter(|(a, b)| a != b).count();
+        assert!(
+            moved > 20,
+            "{falloff:?}: a brush moves many control points ({moved})"
+        );
+    }
+}
+
 #[test]
 fn escape_cancels_a_drag() {
     let _gpu = gpu_lock();

@@ -1006,7 +1006,7 @@ pub fn fit(
 
 /// The least-squares solution of A x = rhs (A given by triplets) through faer's sparse QR, or `None`
 /// where faer panicked (an assertion inside its supernodal factorization; see [`fit`]).
-fn least_squares(
+pub(crate) fn least_squares(
     rows: usize,
     cols: usize,
     triplets: &[Triplet<usize, usize, f64>],

@@ -18,13 +18,16 @@
 //! another pin that shares control points with the moving ones — are left out of the system: their
 //! control points do not move at all, so they stay exactly, and the drag reaches fewer vertices.
 //!
-//! The optional influence radius widens the edit: control points within the radius of the picked
-//! point first move by Δ times a smooth falloff (1 at the point, 0 at the radius), then the
-//! minimum-norm correction makes the dragged point and the pins exact again.
+//! The optional influence radius makes the drag a grab brush defined on the surface
+//! ([`embedding::brush`]): control points first move by their share of Δ in the spline nearest to
+//! "every surface point within the radius moves by Δ times the falloff of its model-space distance",
+//! then the minimum-norm correction makes the dragged point and the pins exact again. The footprint
+//! is then the radius in every chart, whichever chart the point was picked in.
 
 use std::time::Duration;
 
 use charts::ChartPoint;
+use embedding::brush::{BrushSamples, Falloff, grab_shares};
 use embedding::edit::{Constraint, solve};
 use embedding::{ControlId, EmbeddingError, Layout, Point3, Surface, Vector3};
 
@@ -114,22 +117,24 @@ impl DragPlan {
         mesh: &mut LiveMesh,
         point: ChartPoint,
         pins: &[ChartPoint],
-        radius: f64,
+        brush: Option<(f64, Falloff)>,
     ) -> Result<DragPlan, EmbeddingError> {
         let layout = &surface.layout();
         let control = surface.control_points();
         let start_position = layout.eval(control, point).pos;
-        let soft: Vec<(ControlId, f64)> = if radius > 0.0 {
-            control
-                .iter()
-                .enumerate()
-                .filter_map(|(c, q)| {
-                    let s = (q - start_position).norm() / radius;
-                    (s < 1.0).then(|| (ControlId(c as u32), falloff(s)))
-                })
-                .collect()
-        } else {
-            Vec::new()
+        let soft = match brush {
+            Some((radius, falloff)) if radius > 0.0 => {
+                let areas =
+                    embedding::fit::vertex_areas(mesh.positions(), &mesh.tessellation.triangles);
+                let samples = BrushSamples {
+                    stencil: mesh.stencil(),
+                    columns: mesh.columns(),
+                    positions: mesh.positions(),
+                    areas: &areas,
+                };
+                grab_shares(&samples, start_position, radius, falloff)?
+            }
+            _ => Vec::new(),
         };
         // The pins that interact with the drag: grow the set of control points that may move.
         let mut moving = vec![false; control.len()];
@@ -370,10 +375,4 @@ fn split_by_rows(
             offset = end;
         }
     });
-}
-
-/// A smooth falloff on [0, 1]: 1 at 0, 0 at 1, flat at both ends ((1 − s²)³).
-pub fn falloff(s: f64) -> f64 {
-    let t = (1.0 - s * s).max(0.0);
-    t * t * t
 }

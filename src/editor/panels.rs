@@ -418,9 +418,25 @@ fn editing(ui: &mut egui::Ui, state: &mut EditorState, commands: &mut Vec<Comman
     )
     .on_hover_text(
         "Off: the smallest change to the control points that moves the dragged point \
-         (the paper's edit). Otherwise control points within this fraction of the model's \
-         size also follow the drag, fading out at the radius.",
+         (the paper's edit). Otherwise a grab brush: the surface within this fraction of the \
+         model's size follows the drag, fading out at the radius as the profile says.",
     );
+    if state.influence > 0.0 {
+        use embedding::brush::Falloff;
+        egui::ComboBox::from_label("profile")
+            .selected_text(format!("{:?}", state.falloff).to_lowercase())
+            .show_ui(ui, |ui| {
+                for f in [
+                    Falloff::Smooth,
+                    Falloff::Dome,
+                    Falloff::Sharp,
+                    Falloff::Constant,
+                ] {
+                    let name = format!("{f:?}").to_lowercase();
+                    ui.selectable_value(&mut state.falloff, f, name);
+                }
+            });
+    }
     ui.label(format!(
         "Pins ({}): Ctrl + click to add or remove",
         state.pins().len()

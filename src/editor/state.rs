@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
+use embedding::brush::Falloff;
 use embedding::remesh::QualitySettings;
 use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surface, Vector3};
 
@@ -74,6 +75,8 @@ pub struct EditorState {
     saved_state: u64,
     /// The influence radius as a fraction of the model's size (0: off, the paper's edit).
     pub influence: f64,
+    /// How the influence fades towards the radius.
+    pub falloff: Falloff,
     /// Whose control points to show.
     pub control_chart: Option<ChartId>,
     pub last_drag: Option<DragStats>,
@@ -96,6 +99,7 @@ impl EditorState {
             path: None,
             saved_state: 0,
             influence: 0.0,
+            falloff: Falloff::Smooth,
             control_chart: None,
             last_drag: None,
         })
@@ -341,8 +345,8 @@ impl EditorState {
             .filter(|&(i, _)| grab != Grab::Pin(i))
             .map(|(_, &p)| p)
             .collect();
-        let radius = self.influence * self.size();
-        let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, radius)?;
+        let brush = (self.influence > 0.0).then(|| (self.influence * self.size(), self.falloff));
+        let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, brush)?;
         self.drag = Some(Drag {
             plan,
             press_pixel: pixel,
