@@ -10,7 +10,9 @@
 //! - `frame_prepare_full`: a frame's copy-out with every vertex uploaded (after a style change);
 //! - `drag_start` and `drag_release`: what a press (planning the drag: gains of every reached
 //!   vertex) and a release (recomputing the moved rows exactly from the stencil) cost, once per
-//!   drag.
+//!   drag;
+//! - `brush_start` and `brush_event`: the same with an influence radius of 15% (a grab brush:
+//!   planning adds the least-squares shares of the falloff field).
 
 use std::hint::black_box;
 
@@ -117,6 +119,32 @@ fn drag(c: &mut Criterion) {
             b.iter(|| plan.move_vertices(black_box(target() - start), &mut vertices))
         });
         state.cancel_drag();
+        // The grab brush (influence radius 15% of the model's size): planning it (the least-squares
+        // shares) and one event.
+        state.influence = 0.15;
+        group.bench_function(BenchmarkId::new("brush_start", n), |b| {
+            b.iter_custom(|iters| {
+                let mut total = std::time::Duration::ZERO;
+                for _ in 0..iters {
+                    let started = std::time::Instant::now();
+                    state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+                    total += started.elapsed();
+                    state.cancel_drag();
+                }
+                total
+            })
+        });
+        state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+        println!(
+            "a brush of 15% moves {} control points and reaches {} vertices",
+            state.drag().map_or(0, |d| d.plan.touched.len()),
+            state.drag().map_or(0, |d| d.plan.rows.len())
+        );
+        group.bench_function(BenchmarkId::new("brush_event", n), |b| {
+            b.iter(|| state.drag_to_target(black_box(target())).unwrap())
+        });
+        state.cancel_drag();
+        state.influence = 0.0;
         group.bench_function(BenchmarkId::new("frame_prepare_full", n), |b| {
             let mut staging: Vec<u8> = Vec::new();
             b.iter(|| {

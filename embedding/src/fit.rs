@@ -1052,7 +1052,7 @@ fn caught_quietly<R>(f: impl FnOnce() -> R) -> std::thread::Result<R> {
 
 /// Second differences of every chart's control grid: along u, along v, and the mixed difference
 /// (scaled by √2, so the sum of squares is the discrete thin-plate energy).
-fn smoothness_rows(layout: &Layout) -> Vec<Vec<(usize, f64)>> {
+pub(crate) fn smoothness_rows(layout: &Layout) -> Vec<Vec<(usize, f64)>> {
     let g = layout.settings().grid;
     let mut rows = Vec::new();
     for chart in layout.atlas().charts() {

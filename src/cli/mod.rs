@@ -15,6 +15,7 @@ mod info;
 mod new;
 mod render;
 mod report;
+mod sculpt;
 mod tessellate;
 
 /// ntori: smooth closed surfaces of any genus, built from charts glued by linear fractional maps.
@@ -40,6 +41,7 @@ enum Command {
     New(new::Args),
     Fit(fit::Args),
     Edit(edit::Args),
+    Sculpt(sculpt::Args),
     Export(export::Args),
     Render(render::Args),
     Figures(figures::Args),
@@ -54,6 +56,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::New(args) => new::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Edit(args) => edit::run(args),
+        Command::Sculpt(args) => sculpt::run(args),
         Command::Export(args) => export::run(args),
         Command::Render(args) => render::run(args),
         Command::Figures(args) => figures::run(args),

@@ -127,6 +127,8 @@ impl DragPlan {
                 let areas =
                     embedding::fit::vertex_areas(mesh.positions(), &mesh.tessellation.triangles);
                 let samples = BrushSamples {
+                    layout,
+                    points: &mesh.tessellation.vertices,
                     stencil: mesh.stencil(),
                     columns: mesh.columns(),
                     positions: mesh.positions(),

@@ -12,4 +12,5 @@ mod hardening;
 mod info;
 mod new;
 mod render;
+mod sculpt;
 mod tessellate;
