@@ -23,8 +23,7 @@
 //! of the same width in every chart.
 
 use charts::ChartPoint;
-use faer::Mat;
-use faer::sparse::Triplet;
+use nalgebra::{DMatrix, DVector};
 
 use crate::EmbeddingError;
 use crate::spline_surface::ControlId;
@@ -108,85 +107,126 @@ pub fn grab_shares(
     if controls.is_empty() {
         return Ok(Vec::new());
     }
-    let mut rows: Vec<u32> = controls
-        .iter()
-        .flat_map(|&c| stencil.rows_of(columns, c as usize).iter().copied())
-        .collect();
-    rows.sort_unstable();
-    rows.dedup();
-    let column = |c: u32| controls.binary_search(&c).ok();
-    let mean_area = rows.iter().map(|&r| areas[r as usize]).sum::<f64>() / rows.len() as f64;
-    let mut triplets = Vec::new();
-    let mut patch_targets = Vec::new();
-    let mut rhs = Mat::<f64>::zeros(rows.len(), 1);
-    for (i, &r) in rows.iter().enumerate() {
-        let scale = (areas[r as usize] / mean_area).sqrt();
-        for (c, w) in stencil.row(r as usize) {
-            // A control point outside the set stays put: its weight only sees the target.
-            if let Some(j) = column(c) {
-                triplets.push(Triplet::new(i, j, scale * w[0]));
-            }
+    // A bit per vertex rather than a sort: the columns of a wide brush list millions of entries.
+    let mut marks = vec![0u64; positions.len().div_ceil(64)];
+    for &c in &controls {
+        for &r in stencil.rows_of(columns, c as usize) {
+            marks[r as usize / 64] |= 1 << (r % 64);
         }
-        rhs[(i, 0)] = scale * target(r as usize);
     }
-    // Each chart's own patch is fitted too, weighted by its blend (as the initial fit does): the
-    // blend alone leaves the patches free to disagree in the overlaps, and they would ripple.
+    let rows: Vec<u32> = marks
+        .iter()
+        .enumerate()
+        .flat_map(|(w, &bits)| {
+            (0..64u32)
+                .filter(move |b| bits & (1u64 << b) != 0)
+                .map(move |b| (w * 64) as u32 + b)
+        })
+        .collect();
+    // A fine tessellation has far more vertices than the spline has freedom: every k-th of them
+    // (at most SAMPLES_PER_CONTROL per moving control point) fits the same field, each standing
+    // for k vertices' area, and the press stays quick at 10⁶ vertices.
+    let stride = rows
+        .len()
+        .div_ceil(SAMPLES_PER_CONTROL * controls.len())
+        .max(1);
+    let column = |c: u32| controls.binary_search(&c).ok();
+    let mut system = Normal::new(controls.len());
     let mut reps = Vec::new();
     let mut patch = Vec::new();
-    let mut extra = 0;
-    for &r in &rows {
-        let blends = layout.blends(points[r as usize]);
-        layout.atlas().locate_into(points[r as usize], &mut reps);
-        let scale = (areas[r as usize] / mean_area).sqrt();
+    let mut entries = Vec::new();
+    for &r in rows.iter().step_by(stride) {
+        let (r, area) = (r as usize, areas[r as usize]);
+        let goal = target(r);
+        // The blended surface's row.
+        entries.clear();
+        entries.extend(stencil.row(r).filter_map(|(c, w)| Some((column(c)?, w[0]))));
+        system.add(&entries, goal, area);
+        // Each chart's own patch too, weighted by its blend (as the initial fit does): the blend
+        // alone leaves the patches free to disagree in the overlaps, and they would ripple.
+        let blends = layout.blends(points[r]);
+        layout.atlas().locate_into(points[r], &mut reps);
         for (rep, (_, blend)) in reps.iter().zip(&blends) {
             patch.clear();
             layout.patch_weights(*rep, &mut patch);
-            let weight = scale * (PATCH_WEIGHT * blend).sqrt();
-            let row = rows.len() + extra;
-            for &(c, w) in &patch {
-                if let Some(j) = column(c) {
-                    triplets.push(Triplet::new(row, j, weight * w));
-                }
-            }
-            patch_targets.push(weight * target(r as usize));
-            extra += 1;
+            entries.clear();
+            entries.extend(patch.iter().filter_map(|&(c, w)| Some((column(c)?, w))));
+            system.add(&entries, goal, area * PATCH_WEIGHT * blend);
         }
     }
-    // Fairness: the second differences of the shares over each chart's control grid, with the
-    // control points outside the set held at 0, so steep profiles (a dome's rim) do not ripple.
+    // The data rows (blended and patch, about two per vertex reached) as if each had weight 1 on
+    // average, against fairness rows of weight FAIRNESS²: the second differences of the shares
+    // over each chart's control grid, with the control points outside the set held at 0, so steep
+    // profiles (a dome's rim) do not ring.
+    system.scale(2.0 * rows.len() as f64 / system.weight.max(f64::MIN_POSITIVE));
     for row in crate::fit::smoothness_rows(layout) {
-        if !row.iter().any(|&(c, _)| column(c as u32).is_some()) {
-            continue;
+        entries.clear();
+        entries.extend(
+            row.iter()
+                .filter_map(|&(c, w)| Some((column(c as u32)?, w))),
+        );
+        if !entries.is_empty() {
+            system.add(&entries, 0.0, FAIRNESS * FAIRNESS);
         }
-        let at = rows.len() + extra;
-        for &(c, w) in &row {
-            if let Some(j) = column(c as u32) {
-                triplets.push(Triplet::new(at, j, FAIRNESS * w));
-            }
-        }
-        patch_targets.push(0.0);
-        extra += 1;
     }
-    // A row ε·e_c per control point keeps the system full rank where the samples do not tell
-    // two control points apart; it moves the shares by about ε² of their size.
-    const EPSILON: f64 = 1e-6;
-    let n = rows.len() + extra;
-    triplets.extend((0..controls.len()).map(|j| Triplet::new(n + j, j, EPSILON)));
-    let mut full = Mat::<f64>::zeros(n + controls.len(), 1);
-    for i in 0..rows.len() {
-        full[(i, 0)] = rhs[(i, 0)];
-    }
-    for (k, t) in patch_targets.iter().enumerate() {
-        full[(rows.len() + k, 0)] = *t;
-    }
-    let beta = crate::fit::least_squares(n + controls.len(), controls.len(), &triplets, &full)
-        .ok()
-        .flatten()
-        .ok_or(EmbeddingError::Unsolvable)?;
+    let beta = system.solve().ok_or(EmbeddingError::Unsolvable)?;
     Ok(controls
         .iter()
         .enumerate()
-        .map(|(j, &c)| (ControlId(c), beta[(j, 0)]))
+        .map(|(j, &c)| (ControlId(c), beta[j]))
         .filter(|&(_, b)| b != 0.0)
         .collect())
+}
+
+/// Samples per moving control point at most (the rest of a fine tessellation is skipped evenly).
+const SAMPLES_PER_CONTROL: usize = 24;
+
+/// The normal equations (Σ w aᵢaᵢᵀ) β = Σ w aᵢ tᵢ of a weighted least-squares problem whose rows
+/// are sparse: small (one unknown per moving control point) and dense.
+struct Normal {
+    matrix: DMatrix<f64>,
+    rhs: DVector<f64>,
+    /// Σ w of the rows added since the last [`Normal::scale`].
+    weight: f64,
+}
+
+impl Normal {
+    fn new(n: usize) -> Normal {
+        Normal {
+            matrix: DMatrix::zeros(n, n),
+            rhs: DVector::zeros(n),
+            weight: 0.0,
+        }
+    }
+
+    /// Adds the row Σ aⱼ βⱼ = target with weight w.
+    fn add(&mut self, row: &[(usize, f64)], target: f64, w: f64) {
+        for &(i, a) in row {
+            self.rhs[i] += w * a * target;
+            for &(j, b) in row {
+                self.matrix[(i, j)] += w * a * b;
+            }
+        }
+        self.weight += w;
+    }
+
+    fn scale(&mut self, s: f64) {
+        self.matrix *= s;
+        self.rhs *= s;
+        self.weight = 0.0;
+    }
+
+    /// β, with ε² on the diagonal so that control points the samples cannot tell apart still
+    /// get a unique (small) share.
+    fn solve(mut self) -> Option<Vec<f64>> {
+        const EPSILON: f64 = 1e-6;
+        let n = self.rhs.len();
+        for i in 0..n {
+            self.matrix[(i, i)] += EPSILON * EPSILON;
+        }
+        let beta = self.matrix.cholesky()?.solve(&self.rhs);
+        beta.iter()
+            .all(|b| b.is_finite())
+            .then(|| beta.iter().copied().collect())
+    }
 }
