@@ -5,8 +5,10 @@
 //! the brush's centre c, in model space. That field is not a spline, so the brush moves the control
 //! points by the least-squares spline nearest to it: per control point a share β_c of Δ (the field
 //! is linear in Δ, so the shares are computed once per press), fitted over the tessellation's
-//! vertices that the moving control points reach, each weighted by its area, so that dense and
-//! sparse parts of the tessellation count alike. Vertices beyond the radius that those control
+//! vertices that the moving control points reach (at most 24 per moving control point, taken
+//! evenly), each weighted by its area, so that dense and sparse parts of the tessellation count
+//! alike. The unknowns are few (one per moving control point), so the normal equations are
+//! formed and solved by a dense Cholesky factorization. Vertices beyond the radius that those control
 //! points reach are in the fit with target 0, which keeps the edit inside the brush. The dragged
 //! point and the pins are then made exact by the minimum-norm correction of [`crate::edit`].
 //!

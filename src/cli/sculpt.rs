@@ -28,7 +28,8 @@ use super::report::{Report, emit};
 /// (and to each --pin). The report says how far that was from the point given.
 ///
 /// The output is written atomically; it may not be the input, and an existing file is replaced
-/// only with --force.
+/// only with --force. Where pins keep the point from reaching --to (a pin at the point itself),
+/// the closest compromise is written and the exit status is 3.
 ///
 /// Examples:
 ///   ntori sculpt model.json -o pulled.json --at 1.5,0,0.4 --to 1.5,0,1.2 --radius 1.5

@@ -65,6 +65,22 @@ fn a_stroke_moves_the_point_and_stays_inside_its_radius() {
         far <= 0.1 * lift,
         "beyond the brush the surface moved by {far}"
     );
+    // A pin at the grabbed point itself: the compromise is written, and the exit status says so.
+    let held = dir.path().join("held.json");
+    ntori()
+        .args(["sculpt", &input.display().to_string(), "-o"])
+        .arg(&held)
+        .args([
+            "--at",
+            &point_arg(at),
+            "--to",
+            &point_arg(to),
+            "--pin",
+            &point_arg(at),
+        ])
+        .assert()
+        .code(3);
+    assert!(ntori::io::model_file::load(&held).is_ok());
     // The paper's edit (no radius) moves fewer control points.
     let (paper, _) = run("paper.json", &[]);
     assert!(
