@@ -12,12 +12,14 @@ struct PulledVertex {
 };
 
 // A vertex that follows the drag in progress: position and tangents when the drag began, and the
-// gains that multiply the dragged point's displacement (see src/editor/drag.rs).
+// gains per axis that multiply the dragged point's displacement (see src/editor/drag.rs).
 struct DragRow {
     bx: f32, by: f32, bz: f32,
     ux: f32, uy: f32, uz: f32,
     vx: f32, vy: f32, vz: f32,
-    g: f32, gu: f32, gv: f32,
+    gx: f32, gy: f32, gz: f32,
+    gux: f32, guy: f32, guz: f32,
+    gvx: f32, gvy: f32, gvz: f32,
 };
 
 struct Drag {
@@ -38,9 +40,9 @@ fn vs_pulled(@builtin(vertex_index) k: u32) -> VertexOut {
     if (v.flags != 0u) {
         let r = drag_rows[v.flags - 1u];
         let d = drag.delta.xyz;
-        position = vec3<f32>(r.bx, r.by, r.bz) + r.g * d;
-        let su = vec3<f32>(r.ux, r.uy, r.uz) + r.gu * d;
-        let sv = vec3<f32>(r.vx, r.vy, r.vz) + r.gv * d;
+        position = vec3<f32>(r.bx, r.by, r.bz) + vec3<f32>(r.gx, r.gy, r.gz) * d;
+        let su = vec3<f32>(r.ux, r.uy, r.uz) + vec3<f32>(r.gux, r.guy, r.guz) * d;
+        let sv = vec3<f32>(r.vx, r.vy, r.vz) + vec3<f32>(r.gvx, r.gvy, r.gvz) * d;
         normal = normalize(cross(su, sv));
     }
     var out: VertexOut;

@@ -25,12 +25,13 @@
 //! of the same width in every chart.
 
 use charts::ChartPoint;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
 
 use crate::EmbeddingError;
 use crate::spline_surface::ControlId;
 use crate::stencil::{ColumnIndex, Stencil};
-use crate::surface::{Layout, Point3};
+use crate::surface::{Layout, Point3, Vector3};
 
 /// Weight of the patch terms against the blended surface's (the initial fit's default).
 const PATCH_WEIGHT: f64 = 1.0;
@@ -69,16 +70,119 @@ impl Falloff {
     }
 }
 
-/// The tessellation a brush is fitted over: the surface's layout, the vertices (as chart points),
-/// their stencil and its column index, their current positions and their areas (a third of the
-/// triangles' around each).
+/// What a brush does to the surface under it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BrushKind {
+    /// Drags the surface with the picked point (the editor's drag; see [`grab_shares`]).
+    #[default]
+    Grab,
+    /// Pushes the surface out along its normal (a negative strength pulls it in: deflate).
+    Inflate,
+    /// Fairs the surface: one implicit step that lowers the thin-plate energy of the control
+    /// grids under the brush, the centre free to move and the rim held (see [`dab`]): bumps sink,
+    /// dents rise, ripples go, the bending energy goes down.
+    Smooth,
+    /// Moves the surface towards the plane through the brush's area (its weighted centroid, with
+    /// the weighted mean normal).
+    Flatten,
+}
+
+impl BrushKind {
+    /// The name the command line and the panel use.
+    pub fn name(self) -> &'static str {
+        match self {
+            BrushKind::Grab => "grab",
+            BrushKind::Inflate => "inflate",
+            BrushKind::Smooth => "smooth",
+            BrushKind::Flatten => "flatten",
+        }
+    }
+
+    /// Whether the brush acts on every step of a stroke (all but grab, which follows the pointer).
+    pub fn is_stroke(self) -> bool {
+        self != BrushKind::Grab
+    }
+}
+
+/// One dab of a stroke brush: the kind, the radius (model units), the profile and the strength
+/// (1: a full step; see [`dab`]; negative inflates inwards).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Brush {
+    pub kind: BrushKind,
+    pub radius: f64,
+    pub falloff: Falloff,
+    pub strength: f64,
+}
+
+/// How far one dab of strength 1 moves the centre of an inflate brush, as a fraction of the
+/// radius.
+const STEP: f64 = 0.1;
+
+/// Weight of a smooth dab's fairness rows against its data rows (which weigh about 2 per vertex
+/// reached, times their stiffness): a full-strength dab removes most of a bump of the brush's
+/// size in one step (measured in `tests/editor.rs`).
+const SMOOTH_FAIRNESS: f64 = 48.0;
+
+/// Mirror planes through the origin: the X plane (x ↦ −x), Y and Z, in any combination.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Symmetry {
+    pub x: bool,
+    pub y: bool,
+    pub z: bool,
+}
+
+impl Symmetry {
+    /// The mirror images to act on as well as the identity: every product of the chosen
+    /// reflections, as the signs they put on x, y and z (the identity first).
+    pub fn images(self) -> Vec<Vector3> {
+        let mut images = vec![Vector3::new(1.0, 1.0, 1.0)];
+        for (on, axis) in [(self.x, 0), (self.y, 1), (self.z, 2)] {
+            if on {
+                let flipped: Vec<Vector3> = images
+                    .iter()
+                    .map(|s| {
+                        let mut s = *s;
+                        s[axis] = -s[axis];
+                        s
+                    })
+                    .collect();
+                images.extend(flipped);
+            }
+        }
+        images
+    }
+
+    pub fn is_empty(self) -> bool {
+        !(self.x || self.y || self.z)
+    }
+}
+
+/// The tessellation a brush is fitted over: the surface's layout and control points, the vertices
+/// (as chart points), their stencil and its column index, their current positions, tangents and
+/// areas (a third of the triangles' around each), and which way the normal S_u × S_v points (+1
+/// outwards, −1 inwards: [`outward`]).
 pub struct BrushSamples<'a> {
-    pub layout: &'a Layout<'a>,
+    pub layout: Layout<'a>,
+    pub control: &'a [Point3],
     pub points: &'a [ChartPoint],
     pub stencil: &'a Stencil,
     pub columns: &'a ColumnIndex,
     pub positions: &'a [Point3],
+    pub tangents: &'a [[Vector3; 2]],
     pub areas: &'a [f64],
+    pub outward: f64,
+}
+
+/// +1 where S_u × S_v points out of the closed surface, −1 where in: the sign of the enclosed
+/// volume ∫ x·n dA / 3 over the tessellation.
+pub fn outward(positions: &[Point3], tangents: &[[Vector3; 2]], areas: &[f64]) -> f64 {
+    let volume: f64 = positions
+        .iter()
+        .zip(tangents)
+        .zip(areas)
+        .map(|((p, [u, v]), a)| a * p.coords.dot(&u.cross(v).normalize()))
+        .sum();
+    if volume < 0.0 { -1.0 } else { 1.0 }
 }
 
 /// A grab brush of `radius` (model units) centred at `centre` with profile `falloff`: each control
@@ -90,145 +194,564 @@ pub fn grab_shares(
     radius: f64,
     falloff: Falloff,
 ) -> Result<Vec<(ControlId, f64)>, EmbeddingError> {
-    let BrushSamples {
-        layout,
-        points,
-        stencil,
-        columns,
-        positions,
-        areas,
-    } = *samples;
-    let target = |r: usize| falloff.at((positions[r] - centre).norm() / radius);
-    // The control points that reach the brush's disc, then every vertex they reach.
-    let mut controls: Vec<u32> = (0..positions.len())
-        .filter(|&r| (positions[r] - centre).norm() < radius)
-        .flat_map(|r| stencil.row(r).map(|(c, _)| c))
-        .collect();
-    controls.sort_unstable();
-    controls.dedup();
-    if controls.is_empty() {
+    let Some(reach) = Reach::new(samples, &[centre], radius)? else {
         return Ok(Vec::new());
-    }
-    // A bit per vertex rather than a sort: the columns of a wide brush list millions of entries.
-    let mut marks = vec![0u64; positions.len().div_ceil(64)];
-    for &c in &controls {
-        for &r in stencil.rows_of(columns, c as usize) {
-            marks[r as usize / 64] |= 1 << (r % 64);
-        }
-    }
-    let rows: Vec<u32> = marks
+    };
+    let targets: Vec<f64> = reach
+        .samples
         .iter()
-        .enumerate()
-        .flat_map(|(w, &bits)| {
-            (0..64u32)
-                .filter(move |b| bits & (1u64 << b) != 0)
-                .map(move |b| (w * 64) as u32 + b)
-        })
+        .map(|&r| falloff.at((samples.positions[r as usize] - centre).norm() / radius))
         .collect();
-    // A fine tessellation has far more vertices than the spline has freedom: every k-th of them
-    // (at most SAMPLES_PER_CONTROL per moving control point) fits the same field, each standing
-    // for k vertices' area, and the press stays quick at 10⁶ vertices.
-    let stride = rows
-        .len()
-        .div_ceil(SAMPLES_PER_CONTROL * controls.len())
-        .max(1);
-    let column = |c: u32| controls.binary_search(&c).ok();
-    let mut system = Normal::new(controls.len());
-    let mut reps = Vec::new();
-    let mut patch = Vec::new();
-    let mut entries = Vec::new();
-    for &r in rows.iter().step_by(stride) {
-        let (r, area) = (r as usize, areas[r as usize]);
-        let goal = target(r);
-        // The blended surface's row.
-        entries.clear();
-        entries.extend(stencil.row(r).filter_map(|(c, w)| Some((column(c)?, w[0]))));
-        system.add(&entries, goal, area);
-        // Each chart's own patch too, weighted by its blend (as the initial fit does): the blend
-        // alone leaves the patches free to disagree in the overlaps, and they would ripple.
-        let blends = layout.blends(points[r]);
-        layout.atlas().locate_into(points[r], &mut reps);
-        for (rep, (_, blend)) in reps.iter().zip(&blends) {
-            patch.clear();
-            layout.patch_weights(*rep, &mut patch);
-            entries.clear();
-            entries.extend(patch.iter().filter_map(|&(c, w)| Some((column(c)?, w))));
-            system.add(&entries, goal, area * PATCH_WEIGHT * blend);
-        }
-    }
-    // The data rows (blended and patch, about two per vertex reached) as if each had weight 1 on
-    // average, against fairness rows of weight FAIRNESS²: the second differences of the shares
-    // over each chart's control grid, with the control points outside the set held at 0, so steep
-    // profiles (a dome's rim) do not ring.
-    system.scale(2.0 * rows.len() as f64 / system.weight.max(f64::MIN_POSITIVE));
-    for row in crate::fit::smoothness_rows(layout) {
-        entries.clear();
-        entries.extend(
-            row.iter()
-                .filter_map(|&(c, w)| Some((column(c as u32)?, w))),
-        );
-        if !entries.is_empty() {
-            system.add(&entries, 0.0, FAIRNESS * FAIRNESS);
-        }
-    }
-    let beta = system.solve().ok_or(EmbeddingError::Unsolvable)?;
-    Ok(controls
-        .iter()
-        .enumerate()
-        .map(|(j, &c)| (ControlId(c), beta[j]))
-        .filter(|&(_, b)| b != 0.0)
-        .collect())
+    Ok(reach.fit(&targets))
 }
 
-/// Samples per moving control point at most (the rest of a fine tessellation is skipped evenly).
+/// A grab brush with mirror images: the centres (the picked point and its mirror images found on
+/// the surface, in [`Symmetry::images`]'s order) and for each control point that moves, its share
+/// of the displacement per axis: ΔP_c = share ⊙ Δ (the images move by the mirrored Δ, so along each
+/// axis the change is still a multiple of Δ's component). Where images' discs overlap their
+/// weights are divided by their sum above 1, so a point on a mirror plane moves once.
+pub fn grab_shares_mirrored(
+    samples: &BrushSamples,
+    centres: &[(Point3, Vector3)],
+    radius: f64,
+    falloff: Falloff,
+) -> Result<Vec<(ControlId, Vector3)>, EmbeddingError> {
+    let only: Vec<Point3> = centres.iter().map(|c| c.0).collect();
+    let Some(reach) = Reach::new(samples, &only, radius)? else {
+        return Ok(Vec::new());
+    };
+    let targets: Vec<Vector3> = reach
+        .samples
+        .iter()
+        .map(|&r| {
+            let x = samples.positions[r as usize];
+            image_weights(x, centres, radius, falloff)
+                .map(|(k, w)| centres[k].1 * w)
+                .sum()
+        })
+        .collect();
+    Ok(reach.fit(&targets))
+}
+
+/// Each image's weight at x: its falloff, divided by the sum of all of them where that is above 1.
+fn image_weights(
+    x: Point3,
+    centres: &[(Point3, Vector3)],
+    radius: f64,
+    falloff: Falloff,
+) -> impl Iterator<Item = (usize, f64)> {
+    let f: Vec<f64> = centres
+        .iter()
+        .map(|(c, _)| falloff.at((x - c).norm() / radius))
+        .collect();
+    let norm = f.iter().sum::<f64>().max(1.0);
+    f.into_iter()
+        .enumerate()
+        .filter(|&(_, w)| w > 0.0)
+        .map(move |(k, w)| (k, w / norm))
+}
+
+/// One dab of a stroke brush at `centres` (the brush's centre on the surface, then its mirror
+/// images with their signs, as for [`grab_shares_mirrored`]): how far each moving control point
+/// goes. Inflate and flatten have a field — inflate: strength · [`STEP`] · R along the outward
+/// normal; flatten: strength times the way to the plane — faded by the falloff and fitted by the
+/// spline nearest to it, as the grab brush's is. Smooth is one implicit fairing step: the moving
+/// control points minimise the thin-plate energy of their control grids (second differences,
+/// the points outside the brush held) plus each sample's displacement squared times its
+/// stiffness (1/(strength · falloff) − 1: free at a full-strength centre, held at the rim), so
+/// the grids' bending energy can only go down. Grab has no dab (it follows the pointer).
+pub fn dab(
+    samples: &BrushSamples,
+    brush: Brush,
+    centres: &[(Point3, Vector3)],
+) -> Result<Vec<(ControlId, Vector3)>, EmbeddingError> {
+    let Brush {
+        kind,
+        radius,
+        falloff,
+        strength,
+    } = brush;
+    if kind == BrushKind::Grab {
+        return Err(EmbeddingError::NoDab(kind.name()));
+    }
+    let only: Vec<Point3> = centres.iter().map(|c| c.0).collect();
+    let Some(reach) = Reach::new(samples, &only, radius)? else {
+        return Ok(Vec::new());
+    };
+    let normal = |r: usize| {
+        let [u, v] = samples.tangents[r];
+        u.cross(&v).normalize() * samples.outward
+    };
+    let planes = match kind {
+        BrushKind::Flatten => Some(planes(samples, &reach, centres, radius, falloff)),
+        _ => None,
+    };
+    let field = |r: usize| -> Vector3 {
+        let x = samples.positions[r];
+        let weights = image_weights(x, centres, radius, falloff);
+        match kind {
+            BrushKind::Grab => Vector3::zeros(),
+            BrushKind::Inflate => {
+                let w: f64 = weights.map(|(_, w)| w).sum();
+                normal(r) * (strength * STEP * radius * w)
+            }
+            BrushKind::Smooth => unreachable!("smooth is a fairing, not a field"),
+            BrushKind::Flatten => {
+                // Only the side that faces the plane's way moves (see `planes`).
+                let planes = planes.as_ref().expect("planes for flatten");
+                let [u, v] = samples.tangents[r];
+                let here = u.cross(&v).normalize();
+                weights
+                    .map(|(k, w)| {
+                        let (c, n) = planes[k];
+                        let facing = here.dot(&n).max(0.0);
+                        n * ((c - x.coords).dot(&n) * strength * w * facing)
+                    })
+                    .sum()
+            }
+        }
+    };
+    if kind == BrushKind::Smooth {
+        // How firmly each sample holds its place: 1/(s·w) − 1 for strength s and weight w (so the
+        // centre of a full-strength brush is free and the rim held), never below 0.
+        let stiffness: Vec<f64> = reach
+            .samples
+            .iter()
+            .map(|&r| {
+                let x = samples.positions[r as usize];
+                let w: f64 = image_weights(x, centres, radius, falloff)
+                    .map(|(_, w)| w)
+                    .sum();
+                let s = (strength.abs() * w).min(1.0);
+                (1.0 - s) / (s + 1e-3)
+            })
+            .collect();
+        return reach.fair(samples, &stiffness);
+    }
+    let targets: Vec<Vector3> = reach.samples.iter().map(|&r| field(r as usize)).collect();
+    Ok(reach.fit(&targets))
+}
+
+/// For each centre, the plane a flatten brush pulls towards: through the falloff- and
+/// area-weighted centroid of the vertices within the radius that face the way the surface faces at
+/// the centre (a radius wider than a thin part's thickness reaches its far side, which is not
+/// flattened onto the near one), facing their weighted mean normal.
+fn planes(
+    samples: &BrushSamples,
+    reach: &Reach,
+    centres: &[(Point3, Vector3)],
+    radius: f64,
+    falloff: Falloff,
+) -> Vec<(Vector3, Vector3)> {
+    let unit = |r: usize| {
+        let [u, v] = samples.tangents[r];
+        u.cross(&v).normalize()
+    };
+    centres
+        .iter()
+        .map(|(c, _)| {
+            let nearest = reach.inside.iter().map(|&r| r as usize).min_by(|&a, &b| {
+                (samples.positions[a] - c)
+                    .norm()
+                    .total_cmp(&(samples.positions[b] - c).norm())
+            });
+            let facing = nearest.map_or_else(Vector3::z, unit);
+            let (mut sum, mut normal, mut total) = (Vector3::zeros(), Vector3::zeros(), 0.0);
+            for &r in &reach.inside {
+                let r = r as usize;
+                let n = unit(r);
+                let w = samples.areas[r]
+                    * falloff.at((samples.positions[r] - c).norm() / radius)
+                    * n.dot(&facing).max(0.0);
+                if w > 0.0 {
+                    sum += samples.positions[r].coords * w;
+                    normal += n * w;
+                    total += w;
+                }
+            }
+            let n = normal.try_normalize(1e-300).unwrap_or(facing);
+            (sum / total.max(f64::MIN_POSITIVE), n)
+        })
+        .collect()
+}
+
+/// The surface point nearest to `q`, found by Gauss–Newton from `start` (a point near it, e.g. the
+/// nearest tessellation vertex), changing to a deeper chart whenever a step nears the current
+/// one's border. For mirror images "found on the surface".
+pub fn nearest_on_surface(
+    layout: &Layout,
+    control: &[Point3],
+    start: ChartPoint,
+    q: Point3,
+) -> ChartPoint {
+    let atlas = layout.atlas();
+    let mut p = start;
+    for _ in 0..30 {
+        let jet = layout.eval(control, p);
+        let r = q - jet.pos;
+        let (a, b, c) = (
+            jet.du.dot(&jet.du),
+            jet.du.dot(&jet.dv),
+            jet.dv.dot(&jet.dv),
+        );
+        let (g1, g2) = (jet.du.dot(&r), jet.dv.dot(&r));
+        let det = a * c - b * b;
+        if det.abs() < 1e-300 {
+            break;
+        }
+        let step = Complex64::new((c * g1 - b * g2) / det, (a * g2 - b * g1) / det);
+        let next = ChartPoint::new(p.chart, p.coords + step);
+        let Ok(chart) = atlas.chart(p.chart) else {
+            break;
+        };
+        if chart.domain().margin(next.coords) <= 0.05 {
+            // Near the border: carry on in the chart where the point lies deepest.
+            let here = atlas.locate_unchecked(p);
+            let best = here
+                .representations()
+                .iter()
+                .copied()
+                .max_by(|x, y| {
+                    let m = |z: &ChartPoint| {
+                        atlas
+                            .chart(z.chart)
+                            .map_or(f64::NEG_INFINITY, |ch| ch.domain().margin(z.coords))
+                    };
+                    m(x).total_cmp(&m(y))
+                })
+                .unwrap_or(p);
+            if best.chart == p.chart {
+                break;
+            }
+            p = best;
+            continue;
+        }
+        p = next;
+        if step.norm() < 1e-14 {
+            break;
+        }
+    }
+    p
+}
+
+/// The least-squares problem of a brush at some centres: the control points that reach the
+/// brush's discs, the vertices they reach (sampled) and the normal equations over them, factored.
+/// They depend on where the brush is, not on the field it fits, so one factorization serves the
+/// three coordinates of a displacement (or a scalar share).
+struct Reach {
+    /// The moving control points, sorted.
+    controls: Vec<u32>,
+    /// The vertices the fit samples (each with its rows below).
+    samples: Vec<u32>,
+    /// The vertices within the radius of some centre.
+    inside: Vec<u32>,
+    /// The data rows: the sample they belong to (index into `samples`), their weight and their
+    /// entries' range in `entries` (column in `controls`, weight).
+    rows: Vec<(u32, f64, std::ops::Range<u32>)>,
+    entries: Vec<(u32, f64)>,
+    factor: nalgebra::Cholesky<f64, nalgebra::Dyn>,
+}
+
+impl Reach {
+    /// None when no vertex lies within `radius` of any centre.
+    fn new(
+        samples: &BrushSamples,
+        centres: &[Point3],
+        radius: f64,
+    ) -> Result<Option<Reach>, EmbeddingError> {
+        let BrushSamples {
+            layout,
+            points,
+            stencil,
+            columns,
+            positions,
+            areas,
+            ..
+        } = samples;
+        let (points, stencil, columns, positions, areas) =
+            (*points, *stencil, *columns, *positions, *areas);
+        // The control points that reach the brush's discs, then every vertex they reach.
+        let inside: Vec<u32> = (0..positions.len() as u32)
+            .filter(|&r| {
+                let p = positions[r as usize];
+                centres.iter().any(|c| (p - c).norm() < radius)
+            })
+            .collect();
+        let mut controls: Vec<u32> = inside
+            .iter()
+            .flat_map(|&r| stencil.row(r as usize).map(|(c, _)| c))
+            .collect();
+        controls.sort_unstable();
+        controls.dedup();
+        if controls.is_empty() {
+            return Ok(None);
+        }
+        // A bit per vertex rather than a sort: the columns of a wide brush list millions of entries.
+        let mut marks = vec![0u64; positions.len().div_ceil(64)];
+        for &c in &controls {
+            for &r in stencil.rows_of(columns, c as usize) {
+                marks[r as usize / 64] |= 1 << (r % 64);
+            }
+        }
+        let reached: Vec<u32> = marks
+            .iter()
+            .enumerate()
+            .flat_map(|(w, &bits)| {
+                (0..64u32)
+                    .filter(move |b| bits & (1u64 << b) != 0)
+                    .map(move |b| (w * 64) as u32 + b)
+            })
+            .collect();
+        // A fine tessellation has far more vertices than the spline has freedom: one in k of them
+        // (about SAMPLES_PER_CONTROL per moving control point) fits the same field, each standing
+        // for k vertices' area, and the press stays quick at 10⁶ vertices. Which ones is decided
+        // by a hash of |x|, |y|, |z|, not by index: mirror images on a symmetric tessellation are
+        // both taken or both left, so a symmetric stroke stays symmetric.
+        let stride = reached
+            .len()
+            .div_ceil(SAMPLES_PER_CONTROL * controls.len())
+            .max(1);
+        let column = |c: u32| controls.binary_search(&c).ok().map(|j| j as u32);
+        let mut reach = Reach {
+            samples: reached
+                .iter()
+                .copied()
+                .filter(|&r| stride == 1 || mirror_hash(positions[r as usize]) % stride as u64 == 0)
+                .collect(),
+            inside,
+            rows: Vec::new(),
+            entries: Vec::new(),
+            controls: Vec::new(),
+            factor: DMatrix::<f64>::identity(1, 1)
+                .cholesky()
+                .expect("the identity is positive definite"),
+        };
+        let mut reps = Vec::new();
+        let mut patch = Vec::new();
+        for (k, &r) in reach.samples.iter().enumerate() {
+            let (r, area) = (r as usize, areas[r as usize]);
+            // The blended surface's row.
+            let first = reach.entries.len() as u32;
+            reach
+                .entries
+                .extend(stencil.row(r).filter_map(|(c, w)| Some((column(c)?, w[0]))));
+            reach
+                .rows
+                .push((k as u32, area, first..reach.entries.len() as u32));
+            // Each chart's own patch too, weighted by its blend (as the initial fit does): the
+            // blend alone leaves the patches free to disagree in the overlaps, and they would
+            // ripple.
+            let blends = layout.blends(points[r]);
+            layout.atlas().locate_into(points[r], &mut reps);
+            for (rep, (_, blend)) in reps.iter().zip(&blends) {
+                patch.clear();
+                layout.patch_weights(*rep, &mut patch);
+                let first = reach.entries.len() as u32;
+                reach
+                    .entries
+                    .extend(patch.iter().filter_map(|&(c, w)| Some((column(c)?, w))));
+                reach.rows.push((
+                    k as u32,
+                    area * PATCH_WEIGHT * blend,
+                    first..reach.entries.len() as u32,
+                ));
+            }
+        }
+        // The data rows (blended and patch, about two per vertex reached) as if each had weight 1
+        // on average, against fairness rows of weight FAIRNESS²: the second differences of the
+        // shares over each chart's control grid, with the control points outside the set held at
+        // 0, so steep profiles (a dome's rim) do not ring.
+        let total: f64 = reach.rows.iter().map(|r| r.1).sum();
+        let scale = 2.0 * reached.len() as f64 / total.max(f64::MIN_POSITIVE);
+        let mut system = Normal::new(controls.len());
+        let mut entries = Vec::new();
+        for row in &mut reach.rows {
+            row.1 *= scale;
+            entries.clear();
+            entries.extend(
+                reach.entries[row.2.start as usize..row.2.end as usize]
+                    .iter()
+                    .map(|&(j, w)| (j as usize, w)),
+            );
+            system.add(&entries, row.1);
+        }
+        let fairness = FAIRNESS * FAIRNESS;
+        for row in crate::fit::smoothness_rows(layout) {
+            entries.clear();
+            entries.extend(
+                row.iter()
+                    .filter_map(|&(c, w)| Some((column(c as u32)? as usize, w))),
+            );
+            if !entries.is_empty() {
+                system.add(&entries, fairness);
+            }
+        }
+        reach.factor = system.factor().ok_or(EmbeddingError::Unsolvable)?;
+        reach.controls = controls;
+        Ok(Some(reach))
+    }
+
+    /// One implicit fairing step (see [`dab`]): the displacements of the moving control points
+    /// that minimise the fairness rows' energy of the displaced control points plus Σ stiffness ·
+    /// |displacement|² over the samples.
+    fn fair(
+        &self,
+        samples: &BrushSamples,
+        stiffness: &[f64],
+    ) -> Result<Vec<(ControlId, Vector3)>, EmbeddingError> {
+        let n = self.controls.len();
+        let column = |c: u32| self.controls.binary_search(&c).ok();
+        let mut system = Normal::new(n);
+        let mut entries = Vec::new();
+        for (k, w, range) in &self.rows {
+            entries.clear();
+            entries.extend(
+                self.entries[range.start as usize..range.end as usize]
+                    .iter()
+                    .map(|&(j, a)| (j as usize, a)),
+            );
+            system.add(&entries, w * stiffness[*k as usize]);
+        }
+        let mut rhs = DMatrix::<f64>::zeros(n, 3);
+        for row in crate::fit::smoothness_rows(&samples.layout) {
+            entries.clear();
+            entries.extend(
+                row.iter()
+                    .filter_map(|&(c, w)| Some((column(c as u32)?, w))),
+            );
+            if entries.is_empty() {
+                continue;
+            }
+            system.add(&entries, SMOOTH_FAIRNESS);
+            let now: Vector3 = row
+                .iter()
+                .map(|&(c, w)| samples.control[c].coords * w)
+                .sum();
+            for &(j, a) in &entries {
+                for d in 0..3 {
+                    rhs[(j, d)] -= SMOOTH_FAIRNESS * a * now[d];
+                }
+            }
+        }
+        let factor = system.factor().ok_or(EmbeddingError::Unsolvable)?;
+        let x = factor.solve(&rhs);
+        Ok(self
+            .controls
+            .iter()
+            .enumerate()
+            .map(|(j, &c)| (ControlId(c), Vector3::new(x[(j, 0)], x[(j, 1)], x[(j, 2)])))
+            .filter(|(_, d)| *d != Vector3::zeros() && d.iter().all(|v| v.is_finite()))
+            .collect())
+    }
+
+    /// The spline displacement nearest to `targets` (one per sample; f64 for shares, Vector3 for
+    /// displacements): each moving control point's value, zeros left out.
+    fn fit<T: Target>(&self, targets: &[T]) -> Vec<(ControlId, T)> {
+        let n = self.controls.len();
+        let mut rhs = DMatrix::<f64>::zeros(n, T::DIM);
+        for (k, w, range) in &self.rows {
+            let t = targets[*k as usize].components();
+            for &(j, a) in &self.entries[range.start as usize..range.end as usize] {
+                for (d, t) in t.iter().enumerate() {
+                    rhs[(j as usize, d)] += w * a * t;
+                }
+            }
+        }
+        let x = self.factor.solve(&rhs);
+        self.controls
+            .iter()
+            .enumerate()
+            .map(|(j, &c)| (ControlId(c), T::from_row(x.row(j).iter().copied())))
+            .filter(|(_, t)| !t.is_zero() && t.is_finite())
+            .collect()
+    }
+}
+
+/// What a brush fits: a scalar share or a displacement.
+trait Target: Copy {
+    const DIM: usize;
+    fn components(&self) -> [f64; 3];
+    fn from_row(row: impl Iterator<Item = f64>) -> Self;
+    fn is_zero(&self) -> bool;
+    fn is_finite(&self) -> bool;
+}
+
+impl Target for f64 {
+    const DIM: usize = 1;
+    fn components(&self) -> [f64; 3] {
+        [*self, 0.0, 0.0]
+    }
+    fn from_row(mut row: impl Iterator<Item = f64>) -> f64 {
+        row.next().unwrap_or(0.0)
+    }
+    fn is_zero(&self) -> bool {
+        *self == 0.0
+    }
+    fn is_finite(&self) -> bool {
+        f64::is_finite(*self)
+    }
+}
+
+impl Target for Vector3 {
+    const DIM: usize = 3;
+    fn components(&self) -> [f64; 3] {
+        [self.x, self.y, self.z]
+    }
+    fn from_row(row: impl Iterator<Item = f64>) -> Vector3 {
+        Vector3::from_iterator(row)
+    }
+    fn is_zero(&self) -> bool {
+        *self == Vector3::zeros()
+    }
+    fn is_finite(&self) -> bool {
+        self.iter().all(|x| x.is_finite())
+    }
+}
+
+/// A hash of a point's coordinates' magnitudes (to 2⁻³⁰ of a unit, well above rounding, far below
+/// vertex spacing): the same for a point and its mirror images.
+fn mirror_hash(p: Point3) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for x in p.iter() {
+        let q = (x.abs() * (1u64 << 30) as f64).round() as u64;
+        h = (h ^ q).wrapping_mul(0x0000_0100_0000_01b3);
+        h ^= h >> 29;
+    }
+    h
+}
+
+/// Samples per moving control point (about; the rest of a fine tessellation is skipped).
 const SAMPLES_PER_CONTROL: usize = 24;
 
-/// The normal equations (Σ w aᵢaᵢᵀ) β = Σ w aᵢ tᵢ of a weighted least-squares problem whose rows
-/// are sparse: small (one unknown per moving control point) and dense.
+/// The normal matrix Σ w aᵢaᵢᵀ of a weighted least-squares problem whose rows are sparse: small
+/// (one unknown per moving control point) and dense.
 struct Normal {
     matrix: DMatrix<f64>,
-    rhs: DVector<f64>,
-    /// Σ w of the rows added since the last [`Normal::scale`].
-    weight: f64,
 }
 
 impl Normal {
     fn new(n: usize) -> Normal {
         Normal {
             matrix: DMatrix::zeros(n, n),
-            rhs: DVector::zeros(n),
-            weight: 0.0,
         }
     }
 
-    /// Adds the row Σ aⱼ βⱼ = target with weight w.
-    fn add(&mut self, row: &[(usize, f64)], target: f64, w: f64) {
+    /// Adds the row a with weight w.
+    fn add(&mut self, row: &[(usize, f64)], w: f64) {
         for &(i, a) in row {
-            self.rhs[i] += w * a * target;
             for &(j, b) in row {
                 self.matrix[(i, j)] += w * a * b;
             }
         }
-        self.weight += w;
     }
 
-    fn scale(&mut self, s: f64) {
-        self.matrix *= s;
-        self.rhs *= s;
-        self.weight = 0.0;
-    }
-
-    /// β, with ε² on the diagonal so that control points the samples cannot tell apart still
-    /// get a unique (small) share.
-    fn solve(mut self) -> Option<Vec<f64>> {
+    /// The Cholesky factor, with ε² on the diagonal so that control points the samples cannot
+    /// tell apart still get a unique (small) value.
+    fn factor(mut self) -> Option<nalgebra::Cholesky<f64, nalgebra::Dyn>> {
         const EPSILON: f64 = 1e-6;
-        let n = self.rhs.len();
-        for i in 0..n {
+        for i in 0..self.matrix.nrows() {
             self.matrix[(i, i)] += EPSILON * EPSILON;
         }
-        let beta = self.matrix.cholesky()?.solve(&self.rhs);
-        beta.iter()
-            .all(|b| b.is_finite())
-            .then(|| beta.iter().copied().collect())
+        self.matrix.cholesky()
     }
 }

@@ -77,6 +77,8 @@ pub enum EmbeddingError {
     BadTarget(usize),
     #[error("the edit's constraints could not be solved")]
     Unsolvable,
+    #[error("the {0} brush has no dab: it follows the pointer")]
+    NoDab(&'static str),
     #[error(
         "genus {genus} at mesh resolution {resolution} makes {}{triangles} input triangles, which would take about {:.1} GB to fit ({} bytes a triangle, measured); the fit takes at most {max} triangles: lower the resolution",
         if *.at_least { "more than " } else { "" },

@@ -224,14 +224,21 @@ fn a_grab_brush_has_the_same_footprint_in_every_kind_of_chart() {
     let columns = stencil.column_index(layout.control_count());
     let mut positions = vec![Point3::origin(); stencil.rows()];
     stencil.positions(model.control_points(), &mut positions);
+    let mut du = vec![Vector3::zeros(); stencil.rows()];
+    let mut dv = du.clone();
+    stencil.derivatives(model.control_points(), &mut du, &mut dv);
+    let tangents: Vec<[Vector3; 2]> = du.into_iter().zip(dv).map(|(u, v)| [u, v]).collect();
     let areas = embedding::fit::vertex_areas(&positions, &points.triangles);
     let samples = BrushSamples {
-        layout: &layout,
+        layout: layout.clone(),
+        control: model.control_points(),
         points: &points.vertices,
         stencil: &stencil,
         columns: &columns,
         positions: &positions,
+        tangents: &tangents,
         areas: &areas,
+        outward: embedding::brush::outward(&positions, &tangents, &areas),
     };
     let size = embedding::fit::diagonal(&positions);
     let kinds = [

@@ -27,7 +27,7 @@
 use std::time::Duration;
 
 use charts::ChartPoint;
-use embedding::brush::{BrushSamples, Falloff, grab_shares};
+use embedding::brush::{Falloff, grab_shares_mirrored};
 use embedding::edit::{Constraint, solve};
 use embedding::{ControlId, EmbeddingError, Layout, Point3, Surface, Vector3};
 
@@ -73,12 +73,13 @@ pub struct DragStats {
 }
 
 /// A vertex a drag moves, as the GPU reads it: its position and tangents when the drag began, and
-/// its gains (position = base + g Δ, S_u = u + g_u Δ, S_v = v + g_v Δ). 48 bytes.
+/// its gains per axis (position = base + g ⊙ Δ, S_u = u + g_u ⊙ Δ, S_v = v + g_v ⊙ Δ: with mirror
+/// symmetry the images move by the mirrored Δ, so the three axes' gains differ). 72 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DragRow {
     pub base: [f32; 9],
-    pub gain: [f32; 3],
+    pub gain: [f32; 9],
 }
 
 static NEXT_PLAN: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
@@ -93,11 +94,14 @@ pub struct DragPlan {
     pub pins: Vec<Constraint>,
     /// The control points when the drag began.
     pub start_control: Vec<Point3>,
-    /// Influence: control point and falloff weight.
-    soft: Vec<(ControlId, f64)>,
-    /// Every control point an event may move (sorted), and how: ΔP_c = beta_c Δ.
+    /// The dragged point's mirror images on the surface (symmetry), where they were when the
+    /// drag began, and the signs that mirror Δ for them.
+    pub images: Vec<(ChartPoint, Point3, Vector3)>,
+    /// Influence: control point and its share of Δ per axis.
+    soft: Vec<(ControlId, Vector3)>,
+    /// Every control point an event may move (sorted), and how: ΔP_c = beta_c ⊙ Δ.
     pub touched: Vec<ControlId>,
-    beta: Vec<f64>,
+    beta: Vec<Vector3>,
     /// The vertices those control points reach (sorted), and how they move.
     pub rows: Vec<u32>,
     pub moves: Vec<DragRow>,
@@ -110,44 +114,45 @@ pub struct DragPlan {
 }
 
 impl DragPlan {
-    /// Plans a drag of `point` with `pins` held, from the current control points; `radius` (0: off)
-    /// is the influence radius in model units.
+    /// Plans a drag of `point` with `pins` held, from the current control points; `brush` is the
+    /// influence radius in model units and its falloff (None: the paper's edit); `images` are the
+    /// point's mirror images on the surface with the signs that mirror a displacement for them.
     pub fn new(
         surface: &Surface,
         mesh: &mut LiveMesh,
         point: ChartPoint,
         pins: &[ChartPoint],
         brush: Option<(f64, Falloff)>,
+        images: &[(ChartPoint, Vector3)],
     ) -> Result<DragPlan, EmbeddingError> {
         let layout = &surface.layout();
         let control = surface.control_points();
         let start_position = layout.eval(control, point).pos;
+        let images: Vec<(ChartPoint, Point3, Vector3)> = images
+            .iter()
+            .map(|&(p, signs)| (p, layout.eval(control, p).pos, signs))
+            .collect();
         let soft = match brush {
             Some((radius, falloff)) if radius > 0.0 => {
-                let areas =
-                    embedding::fit::vertex_areas(mesh.positions(), &mesh.tessellation.triangles);
-                let samples = BrushSamples {
-                    layout,
-                    points: &mesh.tessellation.vertices,
-                    stencil: mesh.stencil(),
-                    columns: mesh.columns(),
-                    positions: mesh.positions(),
-                    areas: &areas,
-                };
-                grab_shares(&samples, start_position, radius, falloff)?
+                let centres: Vec<(Point3, Vector3)> =
+                    std::iter::once((start_position, Vector3::new(1.0, 1.0, 1.0)))
+                        .chain(images.iter().map(|&(_, at, signs)| (at, signs)))
+                        .collect();
+                grab_shares_mirrored(&mesh.brush_samples(surface), &centres, radius, falloff)?
             }
             _ => Vec::new(),
         };
         // The pins that interact with the drag: grow the set of control points that may move.
         let mut moving = vec![false; control.len()];
         let mut row = Vec::new();
-        layout.weights(point, &mut row);
-        for c in row
-            .iter()
-            .map(|w| w.control)
-            .chain(soft.iter().map(|s| s.0.0))
-        {
-            moving[c as usize] = true;
+        for p in std::iter::once(point).chain(images.iter().map(|i| i.0)) {
+            layout.weights(p, &mut row);
+            for w in &row {
+                moving[w.control as usize] = true;
+            }
+        }
+        for s in &soft {
+            moving[s.0.index()] = true;
         }
         let supports: Vec<Vec<u32>> = pins
             .iter()
@@ -187,6 +192,7 @@ impl DragPlan {
             start_position,
             pins,
             start_control: control.to_vec(),
+            images,
             soft,
             touched: Vec::new(),
             beta: Vec::new(),
@@ -196,10 +202,10 @@ impl DragPlan {
             displacement: Vector3::zeros(),
             residual: 0.0,
         };
-        // β by linearity: the change for a unit displacement along x.
-        let (moved, _) = plan.solve(layout, Vector3::x())?;
-        let mut touched: Vec<(ControlId, f64)> =
-            moved.iter().map(|(c, delta)| (*c, delta.x)).collect();
+        // β by linearity, per axis (the images' constraints mirror Δ, each axis on its own): the
+        // change for a displacement of 1 along every axis.
+        let (moved, _) = plan.solve(layout, Vector3::new(1.0, 1.0, 1.0))?;
+        let mut touched: Vec<(ControlId, Vector3)> = moved;
         touched.sort_unstable_by_key(|t| t.0);
         plan.touched = touched.iter().map(|t| t.0).collect();
         plan.beta = touched.iter().map(|t| t.1).collect();
@@ -223,7 +229,7 @@ impl DragPlan {
             .collect();
         // Each reached row's gains from its own stencil row (streamed, in parallel), with β looked up
         // by control point.
-        let mut beta = vec![0.0f64; control.len()];
+        let mut beta = vec![Vector3::zeros(); control.len()];
         for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
             beta[c.index()] = b;
         }
@@ -231,12 +237,14 @@ impl DragPlan {
         plan.moves = vec![DragRow::default(); plan.rows.len()];
         parallel_chunks(&plan.rows, &mut plan.moves, |rows, out| {
             for (o, &r) in out.iter_mut().zip(rows) {
-                let mut g = [0.0f64; 3];
+                let mut g = [0.0f64; 9];
                 for (c, w) in stencil.row(r as usize) {
                     let b = beta[c as usize];
-                    if b != 0.0 {
+                    if b != Vector3::zeros() {
                         for a in 0..3 {
-                            g[a] += w[a] * b;
+                            for axis in 0..3 {
+                                g[3 * a + axis] += w[a] * b[axis];
+                            }
                         }
                     }
                 }
@@ -267,18 +275,25 @@ impl DragPlan {
         if !self.soft.is_empty() {
             let shifted = start.to_mut();
             for &(c, f) in &self.soft {
-                shifted[c.index()] += delta * f;
+                shifted[c.index()] += delta.component_mul(&f);
             }
         }
-        let mut constraints = Vec::with_capacity(1 + self.pins.len());
+        let mut constraints = Vec::with_capacity(1 + self.images.len() + self.pins.len());
         constraints.push(Constraint {
             point: self.point,
             target: self.start_position + delta,
         });
+        constraints.extend(self.images.iter().map(|&(point, at, signs)| Constraint {
+            point,
+            target: at + delta.component_mul(&signs),
+        }));
         constraints.extend_from_slice(&self.pins);
         let edit = solve(layout, &start, &constraints)?;
-        let mut moved: Vec<(ControlId, Vector3)> =
-            self.soft.iter().map(|&(c, f)| (c, delta * f)).collect();
+        let mut moved: Vec<(ControlId, Vector3)> = self
+            .soft
+            .iter()
+            .map(|&(c, f)| (c, delta.component_mul(&f)))
+            .collect();
         moved.extend(
             edit.controls
                 .iter()
@@ -329,9 +344,9 @@ impl DragPlan {
         let work = |first: usize, rows: &[u32], out: &mut [ViewVertex], offset: usize| {
             for (k, &r) in (first..).zip(rows) {
                 let DragRow { base: b, gain: g } = &self.moves[k];
-                let p = [b[0] + g[0] * d[0], b[1] + g[0] * d[1], b[2] + g[0] * d[2]];
-                let u = [b[3] + g[1] * d[0], b[4] + g[1] * d[1], b[5] + g[1] * d[2]];
-                let v = [b[6] + g[2] * d[0], b[7] + g[2] * d[1], b[8] + g[2] * d[2]];
+                let p = [b[0] + g[0] * d[0], b[1] + g[1] * d[1], b[2] + g[2] * d[2]];
+                let u = [b[3] + g[3] * d[0], b[4] + g[4] * d[1], b[5] + g[5] * d[2]];
+                let v = [b[6] + g[6] * d[0], b[7] + g[7] * d[1], b[8] + g[8] * d[2]];
                 let n = [
                     u[1] * v[2] - u[2] * v[1],
                     u[2] * v[0] - u[0] * v[2],

@@ -10,6 +10,7 @@ use std::ops::Range;
 
 use bytemuck::{Pod, Zeroable};
 use charts::{ChartId, ChartPoint};
+use embedding::brush::BrushSamples;
 use embedding::remesh::{QualitySettings, quality_mesh};
 use embedding::{
     ColumnIndex, ControlId, Point3, Sample, Stencil, Surface, Vector3, Wants, bounding_box,
@@ -150,6 +151,11 @@ pub struct LiveMesh {
     curvature_range: Option<f64>,
     /// Scratch: a mark per vertex.
     marks: Vec<u64>,
+    /// The vertices' areas and the normal's orientation, for brushes: as of the last
+    /// [`LiveMesh::refresh_brush_weights`] (they weight a brush's samples; an edit changes them a
+    /// little, so a stroke's dabs use the areas of its start).
+    areas: Vec<f64>,
+    outward: f64,
 }
 
 impl LiveMesh {
@@ -178,12 +184,36 @@ impl LiveMesh {
             style,
             curvature_range: None,
             marks: vec![0; n.div_ceil(64)],
+            areas: Vec::new(),
+            outward: 1.0,
         };
         let all: Vec<u32> = (0..n as u32).collect();
         mesh.evaluate(surface, &all, true);
+        mesh.refresh_brush_weights();
         mesh.bvh = Bvh::build(&mesh.positions, &mesh.tessellation.triangles);
         mesh.bvh_stale = false;
         Ok(mesh)
+    }
+
+    /// Recomputes the vertices' areas and which way the normals point (see [`LiveMesh::brush_samples`]).
+    pub fn refresh_brush_weights(&mut self) {
+        self.areas = embedding::fit::vertex_areas(&self.positions, &self.tessellation.triangles);
+        self.outward = embedding::brush::outward(&self.positions, &self.tangents, &self.areas);
+    }
+
+    /// The tessellation as a brush samples it.
+    pub fn brush_samples<'a>(&'a self, surface: &'a Surface) -> BrushSamples<'a> {
+        BrushSamples {
+            layout: surface.layout(),
+            control: surface.control_points(),
+            points: &self.tessellation.vertices,
+            stencil: &self.stencil,
+            columns: &self.columns,
+            positions: &self.positions,
+            tangents: &self.tangents,
+            areas: &self.areas,
+            outward: self.outward,
+        }
     }
 
     pub fn stencil(&self) -> &Stencil {

@@ -38,6 +38,7 @@ mod panels;
 pub mod pick;
 pub mod recovery;
 pub mod state;
+pub mod stroke;
 mod viewport;
 
 pub use app::{EditorApp, EditorOptions};

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use charts::{Atlas, ChartId, ChartPoint, ManifoldPoint};
-use embedding::brush::Falloff;
+use embedding::brush::{Brush, BrushKind, Falloff, Symmetry, nearest_on_surface};
 use embedding::remesh::QualitySettings;
 use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surface, Vector3};
 
@@ -16,6 +16,7 @@ use super::drag::{DragPlan, DragRow};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
+use super::stroke::Stroke;
 use crate::io::export::Meshing;
 use crate::io::model_file::ModelFileError;
 use crate::render::Style;
@@ -43,6 +44,9 @@ pub enum EditorError {
 
 /// The largest t_e or t_r the editor offers (about 1.3 million vertices at genus 2).
 pub const MAX_T: u32 = 256;
+/// A stroke brush's radius, as a fraction of the model's size, when no influence radius is set.
+pub const DEFAULT_STROKE_RADIUS: f64 = 0.15;
+
 /// The t_e and t_r the panel offers first when switching to the t_e/t_r tessellation.
 pub const DEFAULT_T: u32 = 32;
 
@@ -77,6 +81,13 @@ pub struct EditorState {
     pub influence: f64,
     /// How the influence fades towards the radius.
     pub falloff: Falloff,
+    /// What a press and drag does: grab (follow the pointer) or a stroke brush.
+    pub brush: BrushKind,
+    /// A stroke brush's strength (1: a full step per dab; negative: the opposite way).
+    pub strength: f64,
+    /// Mirror planes: a press acts on the picked point's mirror images too.
+    pub symmetry: Symmetry,
+    stroke: Option<Stroke>,
     /// Whose control points to show.
     pub control_chart: Option<ChartId>,
     pub last_drag: Option<DragStats>,
@@ -100,6 +111,10 @@ impl EditorState {
             saved_state: 0,
             influence: 0.0,
             falloff: Falloff::Smooth,
+            brush: BrushKind::Grab,
+            strength: 0.5,
+            symmetry: Symmetry::default(),
+            stroke: None,
             control_chart: None,
             last_drag: None,
         })
@@ -178,6 +193,13 @@ impl EditorState {
     }
     pub fn drag(&self) -> Option<&Drag> {
         self.drag.as_ref()
+    }
+    pub fn stroke(&self) -> Option<&Stroke> {
+        self.stroke.as_ref()
+    }
+    /// Whether a drag or a stroke is in progress.
+    pub fn busy(&self) -> bool {
+        self.drag.is_some() || self.stroke.is_some()
     }
 
     /// The model's size: the diagonal of the tessellation's bounding box.
@@ -314,10 +336,11 @@ impl EditorState {
 
     // ------------------------------------------------------------------------------- dragging
 
-    /// Starts a drag at `pixel`: grabs a pin drawn there, or else the surface point under it.
-    /// Returns what was grabbed (None: nothing there, e.g. to orbit instead).
+    /// Starts a drag at `pixel`: grabs a pin drawn there, or else the surface point under it (with
+    /// a stroke brush: starts a stroke there). Returns what was grabbed (None: nothing there, e.g.
+    /// to orbit instead).
     pub fn press(&mut self, pixel: [f64; 2]) -> Result<Option<Grab>, EditorError> {
-        if self.drag.is_some() {
+        if self.busy() {
             return Ok(None);
         }
         let (point, grab) = if let Some(i) = self.pin_near(pixel, PIN_RADIUS_PX) {
@@ -327,8 +350,53 @@ impl EditorState {
         } else {
             return Ok(None);
         };
-        self.start_drag(point, grab, pixel)?;
+        if grab == Grab::Surface && self.brush.is_stroke() {
+            self.start_stroke(point)?;
+        } else {
+            self.start_drag(point, grab, pixel)?;
+        }
         Ok(Some(grab))
+    }
+
+    /// The brush's radius in model units (0: no radius, the paper's edit).
+    pub fn radius(&self) -> f64 {
+        self.influence * self.size()
+    }
+
+    /// The mirror images of the surface point `point` under [`EditorState::symmetry`], found on
+    /// the surface (the surface point nearest to the mirrored position), with the signs that
+    /// mirror a displacement for each; images that fall on the point itself or on an earlier
+    /// image (a point on a mirror plane) are left out.
+    pub fn mirror_images(&self, point: ChartPoint) -> Vec<(ChartPoint, Vector3)> {
+        let at = self.surface_point(point);
+        let tolerance = 1e-6 * self.size();
+        let mut images: Vec<(ChartPoint, Vector3)> = Vec::new();
+        let mut seen = vec![at];
+        for signs in self.symmetry.images().into_iter().skip(1) {
+            let target = Point3::from(at.coords.component_mul(&signs));
+            let start = self.nearest_vertex(target);
+            let layout = self.layout();
+            let image = nearest_on_surface(&layout, self.control(), start, target);
+            let position = self.surface_point(image);
+            if seen.iter().all(|s| (s - position).norm() > tolerance) {
+                seen.push(position);
+                images.push((image, signs));
+            }
+        }
+        images
+    }
+
+    /// The tessellation vertex nearest to `p`, as a chart point.
+    pub fn nearest_vertex(&self, p: Point3) -> ChartPoint {
+        let k = self
+            .mesh
+            .positions()
+            .iter()
+            .map(|q| (q - p).norm_squared())
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(k, _)| k);
+        self.mesh.tessellation.vertices[k]
     }
 
     /// Starts a drag of `point` (the pointer is at `pixel`).
@@ -345,8 +413,15 @@ impl EditorState {
             .filter(|&(i, _)| grab != Grab::Pin(i))
             .map(|(_, &p)| p)
             .collect();
-        let brush = (self.influence > 0.0).then(|| (self.influence * self.size(), self.falloff));
-        let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, brush)?;
+        let brush = (self.influence > 0.0).then(|| (self.radius(), self.falloff));
+        let images = match grab {
+            Grab::Surface => self.mirror_images(point),
+            Grab::Pin(_) => Vec::new(),
+        };
+        if brush.is_some() {
+            self.mesh.refresh_brush_weights();
+        }
+        let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, brush, &images)?;
         self.drag = Some(Drag {
             plan,
             press_pixel: pixel,
@@ -356,6 +431,64 @@ impl EditorState {
             last: Duration::ZERO,
         });
         Ok(())
+    }
+
+    /// Starts a stroke of the current (stroke) brush with a dab at `point`. A stroke brush needs a
+    /// radius: without an influence radius it uses [`DEFAULT_STROKE_RADIUS`] of the model's size.
+    pub fn start_stroke(&mut self, point: ChartPoint) -> Result<(), EditorError> {
+        if self.busy() {
+            return Ok(());
+        }
+        if self.influence <= 0.0 {
+            self.influence = DEFAULT_STROKE_RADIUS;
+        }
+        let brush = Brush {
+            kind: self.brush,
+            radius: self.radius(),
+            falloff: self.falloff,
+            strength: self.strength,
+        };
+        self.mesh.refresh_brush_weights();
+        self.stroke = Some(Stroke::new(brush, self.control().len()));
+        self.stroke_at(point)
+    }
+
+    /// The stroke's pointer is over `point`: a dab there if it has moved far enough since the last.
+    pub fn stroke_at(&mut self, point: ChartPoint) -> Result<(), EditorError> {
+        let at = self.surface_point(point);
+        if !self.stroke.as_ref().is_some_and(|s| s.due(at)) {
+            return Ok(());
+        }
+        let centres: Vec<(Point3, Vector3)> = std::iter::once((at, Vector3::new(1.0, 1.0, 1.0)))
+            .chain(
+                self.mirror_images(point)
+                    .into_iter()
+                    .map(|(p, signs)| (self.surface_point(p), signs)),
+            )
+            .collect();
+        let stroke = self.stroke.as_mut().expect("a stroke in progress");
+        stroke.dab(&mut self.surface, &mut self.mesh, &centres)?;
+        Ok(())
+    }
+
+    /// Ends the stroke: one undoable change, the control points it moved.
+    pub fn end_stroke(&mut self) {
+        let Some(stroke) = self.stroke.take() else {
+            return;
+        };
+        let (indices, before): (Vec<ControlId>, Vec<Point3>) = stroke.moved().unzip();
+        if indices.is_empty() {
+            return;
+        }
+        let after = indices.iter().map(|c| self.control()[c.index()]).collect();
+        self.history.push(
+            stroke.brush.kind.name(),
+            Change::Controls {
+                indices,
+                before,
+                after,
+            },
+        );
     }
 
     /// Where a drag that pressed at `press` and is now at `pixel` wants its point: the start
@@ -368,8 +501,15 @@ impl EditorState {
         anchor + (b - a)
     }
 
-    /// A drag event: the pointer is at `pixel`. Solves and moves the affected vertices.
+    /// A drag event: the pointer is at `pixel`. Solves and moves the affected vertices (in a
+    /// stroke: a dab at the surface point under the pointer, when it is due).
     pub fn drag_to(&mut self, pixel: [f64; 2]) -> Result<(), EditorError> {
+        if self.stroke.is_some() {
+            if let Some(pick) = self.pick(pixel) {
+                self.stroke_at(pick.point)?;
+            }
+            return Ok(());
+        }
         let Some(drag) = &self.drag else {
             return Ok(());
         };
@@ -411,8 +551,10 @@ impl EditorState {
         f(&mut self.mesh, drag)
     }
 
-    /// Ends the drag: the moved vertices are recomputed exactly and the change joins the history.
+    /// Ends the drag (or the stroke): the moved vertices are recomputed exactly and the change
+    /// joins the history.
     pub fn release(&mut self) {
+        self.end_stroke();
         let Some(drag) = self.drag.take() else {
             return;
         };
@@ -454,8 +596,19 @@ impl EditorState {
         );
     }
 
-    /// Abandons the drag: the control points go back to where they were.
+    /// Abandons the drag (or the stroke): the control points go back to where they were.
     pub fn cancel_drag(&mut self) {
+        if let Some(stroke) = self.stroke.take() {
+            let (indices, before): (Vec<ControlId>, Vec<Point3>) = stroke.moved().unzip();
+            // The starting control points were valid, so restoring them cannot fail.
+            if self
+                .surface
+                .set_control_points_at(indices.iter().copied().zip(before))
+                .is_ok()
+            {
+                self.mesh.controls_changed(&self.surface, &indices);
+            }
+        }
         let Some(drag) = self.drag.take() else {
             return;
         };
@@ -470,15 +623,15 @@ impl EditorState {
     // ------------------------------------------------------------------------------- history
 
     pub fn can_undo(&self) -> bool {
-        self.drag.is_none() && self.history.can_undo()
+        !self.busy() && self.history.can_undo()
     }
     pub fn can_redo(&self) -> bool {
-        self.drag.is_none() && self.history.can_redo()
+        !self.busy() && self.history.can_redo()
     }
 
     /// Reverts the last change. Returns its label.
     pub fn undo(&mut self) -> Result<Option<String>, EditorError> {
-        if self.drag.is_some() {
+        if self.busy() {
             return Ok(None);
         }
         let Some(entry) = self.history.undo() else {
@@ -491,7 +644,7 @@ impl EditorState {
 
     /// Applies the last undone change again. Returns its label.
     pub fn redo(&mut self) -> Result<Option<String>, EditorError> {
-        if self.drag.is_some() {
+        if self.busy() {
             return Ok(None);
         }
         let Some(entry) = self.history.redo() else {
