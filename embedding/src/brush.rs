@@ -516,7 +516,9 @@ impl Reach {
             samples: reached
                 .iter()
                 .copied()
-                .filter(|&r| stride == 1 || mirror_hash(positions[r as usize]) % stride as u64 == 0)
+                .filter(|&r| {
+                    stride == 1 || mirror_hash(positions[r as usize]).is_multiple_of(stride as u64)
+                })
                 .collect(),
             inside,
             rows: Vec::new(),
