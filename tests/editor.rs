@@ -1520,3 +1520,96 @@ fn symmetry_mirrors_the_edit_in_one_solve() {
     println!("genus 2: moved {right:e} on the picked side, {left:e} on the other");
     assert!(right > 1e-3 * size && (left / right - 1.0).abs() < 0.05);
 }
+
+/// In the window: `]` and `[` scale the brush's radius, Shift + `]` and `[` change the strength
+/// (Blender's keys); a stroke of each brush dragged across the surface is one undo step; the
+/// radius is drawn as a ring on the surface under the cursor. Screenshots of each brush's result
+/// (shaded, with the ring) are kept under the target directory.
+#[test]
+fn brush_keys_strokes_and_the_radius_ring() {
+    use embedding::brush::BrushKind;
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    harness.state_mut().state_mut().unwrap().influence = 0.1;
+    harness.key_press(Key::CloseBracket);
+    harness.run();
+    let influence = harness.state().state().unwrap().influence;
+    assert!((influence - 0.11).abs() < 1e-12, "] grows the radius: {influence}");
+    harness.key_press(Key::OpenBracket);
+    harness.key_press(Key::OpenBracket);
+    harness.run();
+    let influence = harness.state().state().unwrap().influence;
+    assert!((influence - 0.1 / 1.1).abs() < 1e-12, "[ shrinks it: {influence}");
+    harness.key_press_modifiers(Modifiers::SHIFT, Key::CloseBracket);
+    harness.run();
+    assert_eq!(harness.state().state().unwrap().strength, 0.55);
+    harness.key_press_modifiers(Modifiers::SHIFT, Key::OpenBracket);
+    harness.key_press_modifiers(Modifiers::SHIFT, Key::OpenBracket);
+    harness.run();
+    assert_eq!(harness.state().state().unwrap().strength, 0.45);
+
+    // The ring: the same hover with and without a radius.
+    let (_, pixel) = visible_vertex(harness.state_mut(), [0.5, 0.5]);
+    let start = pos_of(harness.state(), pixel);
+    let yellow = |harness: &mut Harness<'static, EditorApp>| {
+        let image = harness.render().expect("the window renders");
+        image
+            .pixels()
+            .filter(|p| p[0] > 200 && p[1] > 170 && p[2] < 120)
+            .count()
+    };
+    harness.hover_at(start);
+    harness.run();
+    let with_ring = yellow(&mut harness);
+    harness.state_mut().state_mut().unwrap().influence = 0.0;
+    harness.hover_at(start + Vec2::new(1.0, 0.0));
+    harness.run();
+    let without = yellow(&mut harness);
+    println!("yellow pixels: {with_ring} with the ring, {without} without");
+    assert!(with_ring > without + 200, "the radius ring is drawn");
+
+    for kind in [
+        BrushKind::Grab,
+        BrushKind::Inflate,
+        BrushKind::Smooth,
+        BrushKind::Flatten,
+    ] {
+        {
+            let state = harness.state_mut().state_mut().unwrap();
+            state.brush = kind;
+            state.influence = 0.12;
+            state.strength = 0.8;
+        }
+        let before = harness.state().state().unwrap().control().to_vec();
+        let undo_steps = harness.state().state().unwrap().history().len();
+        harness.hover_at(start);
+        harness.step();
+        harness.drag_at(start);
+        harness.step();
+        for i in 1..=10 {
+            harness.hover_at(start + Vec2::new(6.0 * i as f32, -3.0 * i as f32));
+            harness.step();
+        }
+        harness.drop_at(start + Vec2::new(60.0, -30.0));
+        harness.run();
+        let state = harness.state().state().unwrap();
+        assert_ne!(state.control(), &before[..], "{kind:?} changed the surface");
+        assert_eq!(
+            state.history().len(),
+            undo_steps + 1,
+            "{kind:?}: the stroke is one undo step"
+        );
+        let path = artefact_dir().join(format!("brush-{}.png", kind.name()));
+        harness.hover_at(start + Vec2::new(60.0, -30.0));
+        harness.run();
+        harness.render().unwrap().save(&path).unwrap();
+        println!("after a {} stroke: {}", kind.name(), path.display());
+        harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+        harness.run();
+        assert_eq!(
+            harness.state().state().unwrap().control(),
+            &before[..],
+            "{kind:?}: one Ctrl + Z undoes the stroke"
+        );
+    }
+}

@@ -94,6 +94,10 @@ pub enum Command {
     SetMeshing(Meshing),
     RemovePin(usize),
     ClearPins,
+    /// Scale the brush's radius by this factor (`[` and `]`).
+    ScaleRadius(f64),
+    /// Change the stroke brushes' strength by this much (Shift + `[` and `]`).
+    AddStrength(f64),
     /// Delete the i-th recovery file offered and stop offering it.
     DiscardOrphan(usize),
     /// Stop offering the i-th recovery file (it stays for the next start).
@@ -101,6 +105,11 @@ pub enum Command {
     /// The background job finished.
     JobDone(JobResult),
 }
+
+/// `[` and `]` scale the brush's radius by this factor.
+const RADIUS_STEP: f64 = 1.1;
+/// Shift + `[` and `]` change the strength by this much.
+const STRENGTH_STEP: f64 = 0.05;
 
 /// Every shortcut, for the help window and the menus.
 pub const SHORTCUTS: &[(&str, &str)] = &[
@@ -120,6 +129,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "shaded, wireframe, charts, Gaussian, mean curvature",
     ),
     ("C", "show the next chart's control points (then none)"),
+    ("[ ]", "brush radius smaller, larger"),
+    ("Shift + [ ]", "brush strength lower, higher"),
     ("Ctrl + Z", "undo"),
     ("Ctrl + Shift + Z, Ctrl + Y", "redo"),
     ("Ctrl + N", "new model"),
@@ -236,6 +247,11 @@ impl KeyContext {
             Key::Num4 => Command::SetStyle(Style::Curvature(CurvatureKind::Gaussian)),
             Key::Num5 => Command::SetStyle(Style::Curvature(CurvatureKind::Mean)),
             Key::C => Command::NextControlNet,
+            // Blender's keys: [ and ] resize the brush, with Shift they change its strength.
+            Key::OpenBracket if m.shift => Command::AddStrength(-STRENGTH_STEP),
+            Key::CloseBracket if m.shift => Command::AddStrength(STRENGTH_STEP),
+            Key::OpenBracket => Command::ScaleRadius(1.0 / RADIUS_STEP),
+            Key::CloseBracket => Command::ScaleRadius(RADIUS_STEP),
             _ => return KeyAction::Pass,
         };
         run(command)
@@ -326,6 +342,8 @@ impl EditorApp {
             Command::ResetView => state.reset_view(),
             Command::SetStyle(style) => state.set_style(style),
             Command::ShowControlNet(chart) => state.control_chart = chart,
+            Command::ScaleRadius(factor) => state.scale_radius(factor),
+            Command::AddStrength(delta) => state.add_strength(delta),
             Command::NextControlNet => {
                 let charts = state.atlas().charts().len() as u32;
                 state.control_chart = match state.control_chart {

@@ -402,9 +402,27 @@ impl SidePanel {
     }
 }
 
-/// The influence radius and the pins.
+/// The brush, its radius, profile and strength, symmetry, and the pins.
 fn editing(ui: &mut egui::Ui, state: &mut EditorState, commands: &mut Vec<Command>) {
+    use embedding::brush::BrushKind;
     ui.label("Editing");
+    egui::ComboBox::from_label("brush")
+        .selected_text(state.brush.name())
+        .show_ui(ui, |ui| {
+            for (kind, tip) in [
+                (BrushKind::Grab, "drag the surface with the pointer"),
+                (BrushKind::Inflate, "push the surface out along its normal"),
+                (BrushKind::Smooth, "fair the surface: bumps sink, dents rise"),
+                (BrushKind::Flatten, "move the surface towards the plane under the brush"),
+            ] {
+                ui.selectable_value(&mut state.brush, kind, kind.name())
+                    .on_hover_text(tip);
+            }
+        });
+    if state.brush.is_stroke() && state.influence <= 0.0 {
+        // A stroke brush needs a radius.
+        state.influence = crate::editor::state::DEFAULT_STROKE_RADIUS;
+    }
     ui.add(
         egui::Slider::new(&mut state.influence, 0.0..=0.5)
             .text("influence radius")
@@ -418,9 +436,24 @@ fn editing(ui: &mut egui::Ui, state: &mut EditorState, commands: &mut Vec<Comman
     )
     .on_hover_text(
         "Off: the smallest change to the control points that moves the dragged point \
-         (the paper's edit). Otherwise a grab brush: the surface within this fraction of the \
-         model's size follows the drag, fading out at the radius as the profile says.",
+         (the paper's edit). Otherwise the brush acts on the surface within this fraction of the \
+         model's size, fading out at the radius as the profile says. [ and ] change it.",
     );
+    if state.brush.is_stroke() {
+        ui.add(egui::Slider::new(&mut state.strength, -1.0..=1.0).text("strength"))
+            .on_hover_text(
+                "How far one dab goes (1: a full step; negative: the other way, e.g. deflate). \
+                 Shift + [ and ] change it.",
+            );
+    }
+    ui.horizontal(|ui| {
+        ui.label("symmetry");
+        ui.checkbox(&mut state.symmetry.x, "X");
+        ui.checkbox(&mut state.symmetry.y, "Y");
+        ui.checkbox(&mut state.symmetry.z, "Z");
+    })
+    .response
+    .on_hover_text("Act on the mirror images across these planes through the origin too.");
     if state.influence > 0.0 {
         use embedding::brush::Falloff;
         egui::ComboBox::from_label("profile")

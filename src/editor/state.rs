@@ -44,6 +44,10 @@ pub enum EditorError {
 
 /// The largest t_e or t_r the editor offers (about 1.3 million vertices at genus 2).
 pub const MAX_T: u32 = 256;
+/// The smallest and largest brush radius the keys give, as fractions of the model's size.
+pub const MIN_RADIUS: f64 = 0.01;
+pub const MAX_RADIUS: f64 = 0.5;
+
 /// A stroke brush's radius, as a fraction of the model's size, when no influence radius is set.
 pub const DEFAULT_STROKE_RADIUS: f64 = 0.15;
 
@@ -356,6 +360,22 @@ impl EditorState {
             self.start_drag(point, grab, pixel)?;
         }
         Ok(Some(grab))
+    }
+
+    /// Scales the brush's radius (as `[` and `]` do): from off, `]` turns it on at the smallest
+    /// radius; it stays between [`MIN_RADIUS`] and [`MAX_RADIUS`] of the model's size.
+    pub fn scale_radius(&mut self, factor: f64) {
+        self.influence = if self.influence <= 0.0 {
+            if factor > 1.0 { MIN_RADIUS } else { 0.0 }
+        } else {
+            (self.influence * factor).clamp(MIN_RADIUS, MAX_RADIUS)
+        };
+    }
+
+    /// Changes the stroke brushes' strength (as Shift + `[` and `]` do), within −1 to 1.
+    pub fn add_strength(&mut self, delta: f64) {
+        self.strength = ((self.strength + delta) * 100.0).round() / 100.0;
+        self.strength = self.strength.clamp(-1.0, 1.0);
     }
 
     /// The brush's radius in model units (0: no radius, the paper's edit).

@@ -222,7 +222,7 @@ impl Viewport {
                 state.camera.zoom(f64::from(zoom));
             }
         }
-        if self.interaction == Interaction::None {
+        if self.interaction == Interaction::None || state.stroke().is_some() {
             self.hover = response
                 .hover_pos()
                 .and_then(|p| state.pick(map.to_pixel(p)));
@@ -359,6 +359,26 @@ impl Viewport {
         {
             painter.circle_stroke(p, 4.0, Stroke::new(1.5, yellow));
         }
+        // The brush's radius, drawn on the surface's tangent plane under the cursor (or at the
+        // dragged point).
+        let brush_at = match dragging {
+            Some((_, point, Grab::Surface)) => Some(point),
+            Some(_) => None,
+            None => self.hover.as_ref().map(|h| h.point),
+        };
+        if state.influence > 0.0
+            && let Some(point) = brush_at
+        {
+            let jet = state.layout().eval(state.control(), point);
+            let ring = brush_ring(jet.pos, jet.normal(), state.radius());
+            let points: Vec<Pos2> = ring.into_iter().filter_map(project).collect();
+            if points.len() == BRUSH_RING_POINTS {
+                painter.add(egui::Shape::closed_line(
+                    points,
+                    Stroke::new(1.5, Color32::from_rgba_unmultiplied(250, 210, 60, 200)),
+                ));
+            }
+        }
         if let Some(pick) = &self.selected
             && let Some(p) = project(state.surface_point(pick.point))
         {
@@ -388,6 +408,26 @@ impl Viewport {
             );
         }
     }
+}
+
+/// Points on the drawn brush circle.
+const BRUSH_RING_POINTS: usize = 64;
+
+/// A circle of `radius` about `centre` in the plane normal to `normal`.
+fn brush_ring(centre: Point3, normal: embedding::Vector3, radius: f64) -> Vec<Point3> {
+    let helper = if normal.x.abs() < 0.9 {
+        embedding::Vector3::x()
+    } else {
+        embedding::Vector3::y()
+    };
+    let a = normal.cross(&helper).normalize();
+    let b = normal.cross(&a);
+    (0..BRUSH_RING_POINTS)
+        .map(|k| {
+            let t = std::f64::consts::TAU * k as f64 / BRUSH_RING_POINTS as f64;
+            centre + (a * t.cos() + b * t.sin()) * radius
+        })
+        .collect()
 }
 
 /// Between egui positions (points) and viewport pixels (physical, from the top left corner).
