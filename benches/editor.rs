@@ -12,7 +12,10 @@
 //!   vertex) and a release (recomputing the moved rows exactly from the stencil) cost, once per
 //!   drag;
 //! - `brush_start` and `brush_event`: the same with an influence radius of 15% (a grab brush:
-//!   planning adds the least-squares shares of the falloff field).
+//!   planning adds the least-squares shares of the falloff field);
+//! - `stroke_step_inflate`, `_smooth`, `_flatten`: one step of a stroke (a dab: the brush's fit,
+//!   the new control points and the exact re-evaluation of the vertices they reach) of a brush
+//!   whose disc covers 5% of the surface's area.
 
 use std::hint::black_box;
 
@@ -144,6 +147,7 @@ fn drag(c: &mut Criterion) {
             b.iter(|| state.drag_to_target(black_box(target())).unwrap())
         });
         state.cancel_drag();
+        stroke_steps(&mut group, &mut state, point, n);
         state.influence = 0.0;
         group.bench_function(BenchmarkId::new("frame_prepare_full", n), |b| {
             let mut staging: Vec<u8> = Vec::new();
@@ -160,6 +164,48 @@ fn drag(c: &mut Criterion) {
         });
     }
     group.finish();
+}
+
+/// One step of each stroke brush, its disc covering 5% of the surface's area: dabs alternate
+/// between two surface points 0.4 R apart, so every step is due.
+fn stroke_steps(
+    group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
+    state: &mut EditorState,
+    point: charts::ChartPoint,
+    n: usize,
+) {
+    use embedding::brush::BrushKind;
+    let mesh = state.mesh();
+    let area: f64 = embedding::fit::vertex_areas(mesh.positions(), &mesh.tessellation.triangles)
+        .iter()
+        .sum();
+    let radius = (0.05 * area / std::f64::consts::PI).sqrt();
+    state.influence = radius / state.size();
+    let at = state.surface_point(point);
+    let other = state.nearest_vertex(at + Vector3::new(0.4 * radius, 0.0, 0.0));
+    for kind in [BrushKind::Inflate, BrushKind::Smooth, BrushKind::Flatten] {
+        state.brush = kind;
+        state.strength = 0.2;
+        state.start_stroke(point).unwrap();
+        println!(
+            "a {} brush of radius {radius:.3} (5% of the area {area:.2}) at {n} vertices",
+            kind.name()
+        );
+        let mut flip = false;
+        group.bench_function(
+            BenchmarkId::new(format!("stroke_step_{}", kind.name()), n),
+            |b| {
+                b.iter(|| {
+                    flip = !flip;
+                    state
+                        .stroke_at(black_box(if flip { other } else { point }))
+                        .unwrap()
+                })
+            },
+        );
+        state.cancel_drag();
+    }
+    state.brush = BrushKind::Grab;
 }
 
 criterion_group!(benches, drag);

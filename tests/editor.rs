@@ -1534,12 +1534,18 @@ fn brush_keys_strokes_and_the_radius_ring() {
     harness.key_press(Key::CloseBracket);
     harness.run();
     let influence = harness.state().state().unwrap().influence;
-    assert!((influence - 0.11).abs() < 1e-12, "] grows the radius: {influence}");
+    assert!(
+        (influence - 0.11).abs() < 1e-12,
+        "] grows the radius: {influence}"
+    );
     harness.key_press(Key::OpenBracket);
     harness.key_press(Key::OpenBracket);
     harness.run();
     let influence = harness.state().state().unwrap().influence;
-    assert!((influence - 0.1 / 1.1).abs() < 1e-12, "[ shrinks it: {influence}");
+    assert!(
+        (influence - 0.1 / 1.1).abs() < 1e-12,
+        "[ shrinks it: {influence}"
+    );
     harness.key_press_modifiers(Modifiers::SHIFT, Key::CloseBracket);
     harness.run();
     assert_eq!(harness.state().state().unwrap().strength, 0.55);

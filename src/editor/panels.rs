@@ -412,8 +412,14 @@ fn editing(ui: &mut egui::Ui, state: &mut EditorState, commands: &mut Vec<Comman
             for (kind, tip) in [
                 (BrushKind::Grab, "drag the surface with the pointer"),
                 (BrushKind::Inflate, "push the surface out along its normal"),
-                (BrushKind::Smooth, "fair the surface: bumps sink, dents rise"),
-                (BrushKind::Flatten, "move the surface towards the plane under the brush"),
+                (
+                    BrushKind::Smooth,
+                    "fair the surface: bumps sink, dents rise",
+                ),
+                (
+                    BrushKind::Flatten,
+                    "move the surface towards the plane under the brush",
+                ),
             ] {
                 ui.selectable_value(&mut state.brush, kind, kind.name())
                     .on_hover_text(tip);
