@@ -253,7 +253,7 @@ fn image_weights(
 
 /// One dab of a stroke brush at `centres` (the brush's centre on the surface, then its mirror
 /// images with their signs, as for [`grab_shares_mirrored`]): how far each moving control point
-/// goes. Inflate and flatten have a field — inflate: strength · [`STEP`] · R along the outward
+/// goes. Inflate and flatten have a field — inflate: strength · 0.1 · R along the outward
 /// normal; flatten: strength times the way to the plane — faded by the falloff and fitted by the
 /// spline nearest to it, as the grab brush's is. Smooth is one implicit fairing step: the moving
 /// control points minimise the thin-plate energy of their control grids (second differences,
