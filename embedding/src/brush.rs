@@ -5,8 +5,9 @@
 //! the brush's centre c, in model space. That field is not a spline, so the brush moves the control
 //! points by the least-squares spline nearest to it: per control point a share β_c of Δ (the field
 //! is linear in Δ, so the shares are computed once per press), fitted over the tessellation's
-//! vertices that the moving control points reach (at most 24 per moving control point, taken
-//! evenly), each weighted by its area, so that dense and sparse parts of the tessellation count
+//! vertices that the moving control points reach (about 32 per moving control point, chosen by a
+//! hash of the position's |x|, |y|, |z| so that mirror images are chosen alike), each weighted by
+//! its area, so that dense and sparse parts of the tessellation count
 //! alike. The unknowns are few (one per moving control point), so the normal equations are
 //! formed and solved by a dense Cholesky factorization. Vertices beyond the radius that those control
 //! points reach are in the fit with target 0, which keeps the edit inside the brush. The dragged
@@ -23,6 +24,11 @@
 //! Because the fit sees only model-space distances and surface samples, the same brush at the
 //! same surface point gives the same shares whichever chart the point was picked in, and footprints
 //! of the same width in every chart.
+//!
+//! The stroke brushes ([`dab`]) use the same least-squares problem (`Reach`) with other fields:
+//! inflate along the outward normal, flatten towards a plane; smooth is an implicit fairing step
+//! of the control grids instead. With [`Symmetry`] the brush acts at the centre's mirror images
+//! too, in one solve.
 
 use charts::ChartPoint;
 use nalgebra::DMatrix;
@@ -202,7 +208,7 @@ pub fn grab_shares(
         .iter()
         .map(|&r| falloff.at((samples.positions[r as usize] - centre).norm() / radius))
         .collect();
-    Ok(reach.fit(&targets))
+    reach.fit(&samples.layout, &targets)
 }
 
 /// A grab brush with mirror images: the centres (the picked point and its mirror images found on
@@ -230,7 +236,7 @@ pub fn grab_shares_mirrored(
                 .sum()
         })
         .collect();
-    Ok(reach.fit(&targets))
+    reach.fit(&samples.layout, &targets)
 }
 
 /// Each image's weight at x: its falloff, divided by the sum of all of them where that is above 1.
@@ -329,7 +335,7 @@ pub fn dab(
         return reach.fair(samples, &stiffness);
     }
     let targets: Vec<Vector3> = reach.samples.iter().map(|&r| field(r as usize)).collect();
-    Ok(reach.fit(&targets))
+    reach.fit(&samples.layout, &targets)
 }
 
 /// For each centre, the plane a flatten brush pulls towards: through the falloff- and
@@ -435,7 +441,7 @@ pub fn nearest_on_surface(
 }
 
 /// The least-squares problem of a brush at some centres: the control points that reach the
-/// brush's discs, the vertices they reach (sampled) and the normal equations over them, factored.
+/// brush's discs, the vertices they reach (sampled) and the rows of the normal equations over them.
 /// They depend on where the brush is, not on the field it fits, so one factorization serves the
 /// three coordinates of a displacement (or a scalar share).
 struct Reach {
@@ -449,7 +455,6 @@ struct Reach {
     /// entries' range in `entries` (column in `controls`, weight).
     rows: Vec<(u32, f64, std::ops::Range<u32>)>,
     entries: Vec<(u32, f64)>,
-    factor: nalgebra::Cholesky<f64, nalgebra::Dyn>,
 }
 
 impl Reach {
@@ -471,18 +476,21 @@ impl Reach {
         let (points, stencil, columns, positions, areas) =
             (*points, *stencil, *columns, *positions, *areas);
         // The control points that reach the brush's discs, then every vertex they reach.
+        let r2 = radius * radius;
         let inside: Vec<u32> = (0..positions.len() as u32)
             .filter(|&r| {
                 let p = positions[r as usize];
-                centres.iter().any(|c| (p - c).norm() < radius)
+                centres.iter().any(|c| (p - c).norm_squared() < r2)
             })
             .collect();
-        let mut controls: Vec<u32> = inside
-            .iter()
-            .flat_map(|&r| stencil.row(r as usize).map(|(c, _)| c))
-            .collect();
-        controls.sort_unstable();
-        controls.dedup();
+        // A bit per control point (few), read out in order.
+        let mut moving = vec![0u64; layout.control_count().div_ceil(64)];
+        for &r in &inside {
+            for (c, _) in stencil.row(r as usize) {
+                moving[c as usize / 64] |= 1u64 << (c % 64);
+            }
+        }
+        let controls = bits_in_order(&moving);
         if controls.is_empty() {
             return Ok(None);
         }
@@ -493,15 +501,7 @@ impl Reach {
                 marks[r as usize / 64] |= 1 << (r % 64);
             }
         }
-        let reached: Vec<u32> = marks
-            .iter()
-            .enumerate()
-            .flat_map(|(w, &bits)| {
-                (0..64u32)
-                    .filter(move |b| bits & (1u64 << b) != 0)
-                    .map(move |b| (w * 64) as u32 + b)
-            })
-            .collect();
+        let reached = bits_in_order(&marks);
         // A fine tessellation has far more vertices than the spline has freedom: one in k of them
         // (about SAMPLES_PER_CONTROL per moving control point) fits the same field, each standing
         // for k vertices' area, and the press stays quick at 10⁶ vertices. Which ones is decided
@@ -524,9 +524,6 @@ impl Reach {
             rows: Vec::new(),
             entries: Vec::new(),
             controls: Vec::new(),
-            factor: DMatrix::<f64>::identity(1, 1)
-                .cholesky()
-                .expect("the identity is positive definite"),
         };
         let mut reps = Vec::new();
         let mut patch = Vec::new();
@@ -565,32 +562,47 @@ impl Reach {
         // 0, so steep profiles (a dome's rim) do not ring.
         let total: f64 = reach.rows.iter().map(|r| r.1).sum();
         let scale = 2.0 * reached.len() as f64 / total.max(f64::MIN_POSITIVE);
-        let mut system = Normal::new(controls.len());
-        let mut entries = Vec::new();
         for row in &mut reach.rows {
             row.1 *= scale;
+        }
+        reach.controls = controls;
+        Ok(Some(reach))
+    }
+
+    /// The normal matrix of the data rows, each weighted by `stiffness` of its sample too, and
+    /// of the fairness rows with weight `fairness`; `each_fairness_row(moving entries, whole row)`
+    /// sees every fairness row that touches the moving control points.
+    fn assemble(
+        &self,
+        layout: &Layout,
+        stiffness: impl Fn(usize) -> f64,
+        fairness: f64,
+        mut each_fairness_row: impl FnMut(&[(usize, f64)], &[(usize, f64)]),
+    ) -> Normal {
+        let column = |c: u32| self.controls.binary_search(&c).ok();
+        let mut system = Normal::new(self.controls.len());
+        let mut entries = Vec::new();
+        for (k, w, range) in &self.rows {
             entries.clear();
             entries.extend(
-                reach.entries[row.2.start as usize..row.2.end as usize]
+                self.entries[range.start as usize..range.end as usize]
                     .iter()
-                    .map(|&(j, w)| (j as usize, w)),
+                    .map(|&(j, a)| (j as usize, a)),
             );
-            system.add(&entries, row.1);
+            system.add(&entries, w * stiffness(*k as usize));
         }
-        let fairness = FAIRNESS * FAIRNESS;
         for row in crate::fit::smoothness_rows(layout) {
             entries.clear();
             entries.extend(
                 row.iter()
-                    .filter_map(|&(c, w)| Some((column(c as u32)? as usize, w))),
+                    .filter_map(|&(c, w)| Some((column(c as u32)?, w))),
             );
             if !entries.is_empty() {
                 system.add(&entries, fairness);
+                each_fairness_row(&entries, &row);
             }
         }
-        reach.factor = system.factor().ok_or(EmbeddingError::Unsolvable)?;
-        reach.controls = controls;
-        Ok(Some(reach))
+        system
     }
 
     /// One implicit fairing step (see [`dab`]): the displacements of the moving control points
@@ -602,39 +614,23 @@ impl Reach {
         stiffness: &[f64],
     ) -> Result<Vec<(ControlId, Vector3)>, EmbeddingError> {
         let n = self.controls.len();
-        let column = |c: u32| self.controls.binary_search(&c).ok();
-        let mut system = Normal::new(n);
-        let mut entries = Vec::new();
-        for (k, w, range) in &self.rows {
-            entries.clear();
-            entries.extend(
-                self.entries[range.start as usize..range.end as usize]
-                    .iter()
-                    .map(|&(j, a)| (j as usize, a)),
-            );
-            system.add(&entries, w * stiffness[*k as usize]);
-        }
         let mut rhs = DMatrix::<f64>::zeros(n, 3);
-        for row in crate::fit::smoothness_rows(&samples.layout) {
-            entries.clear();
-            entries.extend(
-                row.iter()
-                    .filter_map(|&(c, w)| Some((column(c as u32)?, w))),
-            );
-            if entries.is_empty() {
-                continue;
-            }
-            system.add(&entries, SMOOTH_FAIRNESS);
-            let now: Vector3 = row
-                .iter()
-                .map(|&(c, w)| samples.control[c].coords * w)
-                .sum();
-            for &(j, a) in &entries {
-                for d in 0..3 {
-                    rhs[(j, d)] -= SMOOTH_FAIRNESS * a * now[d];
+        let system = self.assemble(
+            &samples.layout,
+            |k| stiffness[k],
+            SMOOTH_FAIRNESS,
+            |moving, row| {
+                let now: Vector3 = row
+                    .iter()
+                    .map(|&(c, w)| samples.control[c].coords * w)
+                    .sum();
+                for &(j, a) in moving {
+                    for d in 0..3 {
+                        rhs[(j, d)] -= SMOOTH_FAIRNESS * a * now[d];
+                    }
                 }
-            }
-        }
+            },
+        );
         let factor = system.factor().ok_or(EmbeddingError::Unsolvable)?;
         let x = factor.solve(&rhs);
         Ok(self
@@ -648,24 +644,33 @@ impl Reach {
 
     /// The spline displacement nearest to `targets` (one per sample; f64 for shares, Vector3 for
     /// displacements): each moving control point's value, zeros left out.
-    fn fit<T: Target>(&self, targets: &[T]) -> Vec<(ControlId, T)> {
+    fn fit<T: Target>(
+        &self,
+        layout: &Layout,
+        targets: &[T],
+    ) -> Result<Vec<(ControlId, T)>, EmbeddingError> {
+        let factor = self
+            .assemble(layout, |_| 1.0, FAIRNESS * FAIRNESS, |_, _| {})
+            .factor()
+            .ok_or(EmbeddingError::Unsolvable)?;
         let n = self.controls.len();
         let mut rhs = DMatrix::<f64>::zeros(n, T::DIM);
         for (k, w, range) in &self.rows {
             let t = targets[*k as usize].components();
             for &(j, a) in &self.entries[range.start as usize..range.end as usize] {
-                for (d, t) in t.iter().enumerate() {
+                for (d, t) in t.iter().enumerate().take(T::DIM) {
                     rhs[(j as usize, d)] += w * a * t;
                 }
             }
         }
-        let x = self.factor.solve(&rhs);
-        self.controls
+        let x = factor.solve(&rhs);
+        Ok(self
+            .controls
             .iter()
             .enumerate()
             .map(|(j, &c)| (ControlId(c), T::from_row(x.row(j).iter().copied())))
             .filter(|(_, t)| !t.is_zero() && t.is_finite())
-            .collect()
+            .collect())
     }
 }
 
@@ -710,6 +715,19 @@ impl Target for Vector3 {
     }
 }
 
+/// The indices of the set bits, in increasing order.
+fn bits_in_order(bits: &[u64]) -> Vec<u32> {
+    let mut out = Vec::new();
+    for (w, &word) in bits.iter().enumerate() {
+        let mut b = word;
+        while b != 0 {
+            out.push((w * 64) as u32 + b.trailing_zeros());
+            b &= b - 1;
+        }
+    }
+    out
+}
+
 /// A hash of a point's coordinates' magnitudes (to 2⁻³⁰ of a unit, well above rounding, far below
 /// vertex spacing): the same for a point and its mirror images.
 fn mirror_hash(p: Point3) -> u64 {
@@ -723,7 +741,7 @@ fn mirror_hash(p: Point3) -> u64 {
 }
 
 /// Samples per moving control point (about; the rest of a fine tessellation is skipped).
-const SAMPLES_PER_CONTROL: usize = 24;
+const SAMPLES_PER_CONTROL: usize = 32;
 
 /// The normal matrix Σ w aᵢaᵢᵀ of a weighted least-squares problem whose rows are sparse: small
 /// (one unknown per moving control point) and dense.

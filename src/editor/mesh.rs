@@ -156,6 +156,7 @@ pub struct LiveMesh {
     /// little, so a stroke's dabs use the areas of its start).
     areas: Vec<f64>,
     outward: f64,
+    size: f64,
 }
 
 impl LiveMesh {
@@ -186,6 +187,7 @@ impl LiveMesh {
             marks: vec![0; n.div_ceil(64)],
             areas: Vec::new(),
             outward: 1.0,
+            size: 0.0,
         };
         let all: Vec<u32> = (0..n as u32).collect();
         mesh.evaluate(surface, &all, true);
@@ -199,6 +201,8 @@ impl LiveMesh {
     pub fn refresh_brush_weights(&mut self) {
         self.areas = embedding::fit::vertex_areas(&self.positions, &self.tessellation.triangles);
         self.outward = embedding::brush::outward(&self.positions, &self.tangents, &self.areas);
+        let (lo, hi) = bounding_box(&self.positions);
+        self.size = (hi - lo).norm();
     }
 
     /// The tessellation as a brush samples it.
@@ -323,10 +327,11 @@ impl LiveMesh {
         (centre, radius)
     }
 
-    /// The bounding box's diagonal: the model's size.
+    /// The bounding box's diagonal: the model's size (as of the last
+    /// [`LiveMesh::refresh_brush_weights`]: made when the mesh is, and again at each drag's or
+    /// stroke's start, not per edit, for it reads every vertex).
     pub fn size(&self) -> f64 {
-        let (lo, hi) = bounding_box(&self.positions);
-        (hi - lo).norm()
+        self.size
     }
 
     /// Recolours every vertex for `style`.
@@ -338,23 +343,54 @@ impl LiveMesh {
         self.dirty.all = true;
     }
 
-    /// The rows any of `controls` touches, in increasing order.
+    /// The rows any of `controls` touches, in increasing order (marked in a bitmap, read out in
+    /// order: no sort).
     pub fn rows_of_controls(&mut self, controls: &[ControlId]) -> Vec<u32> {
-        let mut rows = Vec::new();
         for &c in controls {
             for &r in self.stencil.rows_of(&self.columns, c.index()) {
-                let (w, bit) = (r as usize / 64, 1u64 << (r % 64));
-                if self.marks[w] & bit == 0 {
-                    self.marks[w] |= bit;
-                    rows.push(r);
-                }
+                self.marks[r as usize / 64] |= 1u64 << (r % 64);
             }
         }
-        for &r in &rows {
-            self.marks[r as usize / 64] = 0;
+        let mut rows = Vec::new();
+        for (w, bits) in self.marks.iter_mut().enumerate() {
+            let mut b = std::mem::take(bits);
+            while b != 0 {
+                rows.push((w * 64) as u32 + b.trailing_zeros());
+                b &= b - 1;
+            }
         }
-        rows.sort_unstable();
         rows
+    }
+
+    /// After a brush's dab moved `controls`: the positions and tangents of the rows they touch
+    /// anew, from the stencil (exact), on all cores. In the shaded and wireframe styles that is
+    /// all a vertex shows; in the others the colours follow too (the full evaluation).
+    pub fn controls_moved(&mut self, surface: &Surface, controls: &[ControlId]) {
+        let rows = self.rows_of_controls(controls);
+        if matches!(self.style, Style::Curvature(_) | Style::Charts) {
+            self.rows_changed(surface, &rows);
+            return;
+        }
+        let control = surface.control_points();
+        let stencil = &self.stencil;
+        let mut jets = vec![(Point3::origin(), [Vector3::zeros(); 2]); rows.len()];
+        embedding::evaluate::parallel_chunks(&rows, &mut jets, |rows, out| {
+            for (o, &r) in out.iter_mut().zip(rows) {
+                *o = stencil.position_and_tangents(control, r as usize);
+            }
+        });
+        for (&r, (p, [u, v])) in rows.iter().zip(jets) {
+            let r = r as usize;
+            self.positions[r] = p;
+            self.tangents[r] = [u, v];
+            let n = u.cross(&v).normalize();
+            let vertex = &mut self.vertices[r];
+            vertex.position = [p.x as f32, p.y as f32, p.z as f32];
+            vertex.normal = [n.x as f32, n.y as f32, n.z as f32];
+            vertex.flags = 0;
+        }
+        self.dirty.add_sorted(&rows);
+        self.bvh_stale = true;
     }
 
     /// After `controls` changed: recomputes exactly the rows they touch (and their colours in the

@@ -67,7 +67,7 @@ impl Stroke {
         }
         surface.set_control_points_at(updates.iter().copied())?;
         let ids: Vec<ControlId> = moved.iter().map(|m| m.0).collect();
-        mesh.controls_changed(surface, &ids);
+        mesh.controls_moved(surface, &ids);
         self.last = centres.first().map(|c| c.0);
         self.dabs += 1;
         self.last_dab = started.elapsed();
