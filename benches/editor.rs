@@ -182,7 +182,25 @@ fn stroke_steps(
     let radius = (0.05 * area / std::f64::consts::PI).sqrt();
     state.influence = radius / state.size();
     let at = state.surface_point(point);
-    let other = state.nearest_vertex(at + Vector3::new(0.4 * radius, 0.0, 0.0));
+    // A vertex 0.3 to 0.5 R away, facing the same way (not across a thin part).
+    let mesh = state.mesh();
+    let normal = |k: usize| {
+        let [u, v] = mesh.tangents()[k];
+        u.cross(&v).normalize()
+    };
+    let here = mesh
+        .tessellation
+        .vertices
+        .iter()
+        .position(|p| *p == point)
+        .expect("the point is a vertex");
+    let other = (0..mesh.vertex_count())
+        .find(|&k| {
+            let d = (mesh.positions()[k] - at).norm();
+            (0.3 * radius..0.5 * radius).contains(&d) && normal(k).dot(&normal(here)) > 0.9
+        })
+        .map(|k| mesh.tessellation.vertices[k])
+        .expect("a vertex near the point");
     for kind in [BrushKind::Inflate, BrushKind::Smooth, BrushKind::Flatten] {
         state.brush = kind;
         state.strength = 0.2;
@@ -203,6 +221,8 @@ fn stroke_steps(
                 })
             },
         );
+        let dabs = state.stroke().map_or(0, |s| s.dabs);
+        assert!(dabs > 1, "every step dabs");
         state.cancel_drag();
     }
     state.brush = BrushKind::Grab;
