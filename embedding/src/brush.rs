@@ -466,15 +466,13 @@ impl Reach {
     ) -> Result<Option<Reach>, EmbeddingError> {
         let BrushSamples {
             layout,
-            points,
             stencil,
             columns,
             positions,
             areas,
             ..
         } = samples;
-        let (points, stencil, columns, positions, areas) =
-            (*points, *stencil, *columns, *positions, *areas);
+        let (stencil, columns, positions, areas) = (*stencil, *columns, *positions, *areas);
         // The control points that reach the brush's discs, then every vertex they reach.
         let r2 = radius * radius;
         let inside: Vec<u32> = (0..positions.len() as u32)
@@ -525,30 +523,36 @@ impl Reach {
             entries: Vec::new(),
             controls: Vec::new(),
         };
-        let mut reps = Vec::new();
-        let mut patch = Vec::new();
+        // Each chart's own patch is fitted too, weighted by its blend (as the initial fit does):
+        // the blend alone leaves the patches free to disagree in the overlaps, and they would
+        // ripple. A stencil row's entries of chart i are β_i N_c (uniform B-splines sum to 1), so
+        // chart i's patch row is those entries over their sum β_i: no second evaluation.
+        let per_chart = (layout.settings().grid * layout.settings().grid) as u32;
+        let mut row = Vec::new();
         for (k, &r) in reach.samples.iter().enumerate() {
             let (r, area) = (r as usize, areas[r as usize]);
+            row.clear();
+            row.extend(stencil.row(r).map(|(c, w)| (c, w[0])));
             // The blended surface's row.
             let first = reach.entries.len() as u32;
             reach
                 .entries
-                .extend(stencil.row(r).filter_map(|(c, w)| Some((column(c)?, w[0]))));
+                .extend(row.iter().filter_map(|&(c, w)| Some((column(c)?, w))));
             reach
                 .rows
                 .push((k as u32, area, first..reach.entries.len() as u32));
-            // Each chart's own patch too, weighted by its blend (as the initial fit does): the
-            // blend alone leaves the patches free to disagree in the overlaps, and they would
-            // ripple.
-            let blends = layout.blends(points[r]);
-            layout.atlas().locate_into(points[r], &mut reps);
-            for (rep, (_, blend)) in reps.iter().zip(&blends) {
-                patch.clear();
-                layout.patch_weights(*rep, &mut patch);
+            // Per chart (the row is sorted by control point, so by chart).
+            for group in row.chunk_by(|a, b| a.0 / per_chart == b.0 / per_chart) {
+                let blend: f64 = group.iter().map(|e| e.1).sum();
+                if blend <= 1e-12 {
+                    continue;
+                }
                 let first = reach.entries.len() as u32;
-                reach
-                    .entries
-                    .extend(patch.iter().filter_map(|&(c, w)| Some((column(c)?, w))));
+                reach.entries.extend(
+                    group
+                        .iter()
+                        .filter_map(|&(c, w)| Some((column(c)?, w / blend))),
+                );
                 reach.rows.push((
                     k as u32,
                     area * PATCH_WEIGHT * blend,
@@ -575,22 +579,54 @@ impl Reach {
     fn assemble(
         &self,
         layout: &Layout,
-        stiffness: impl Fn(usize) -> f64,
+        stiffness: impl Fn(usize) -> f64 + Sync,
         fairness: f64,
         mut each_fairness_row: impl FnMut(&[(usize, f64)], &[(usize, f64)]),
     ) -> Normal {
         let column = |c: u32| self.controls.binary_search(&c).ok();
-        let mut system = Normal::new(self.controls.len());
+        let n = self.controls.len();
+        // The data rows on all cores, each thread into its own matrix, summed.
+        let add_rows = |rows: &[(u32, f64, std::ops::Range<u32>)]| {
+            let mut part = Normal::new(n);
+            let mut entries = Vec::new();
+            for (k, w, range) in rows {
+                entries.clear();
+                entries.extend(
+                    self.entries[range.start as usize..range.end as usize]
+                        .iter()
+                        .map(|&(j, a)| (j as usize, a)),
+                );
+                part.add(&entries, w * stiffness(*k as usize));
+            }
+            part
+        };
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |t| t.get())
+            .min(self.rows.len().div_ceil(4096))
+            .max(1);
+        let per = self.rows.len().div_ceil(threads).max(1);
+        let mut system = if threads == 1 {
+            add_rows(&self.rows)
+        } else {
+            let parts: Vec<Normal> = std::thread::scope(|scope| {
+                let handles: Vec<_> = self
+                    .rows
+                    .chunks(per)
+                    .map(|chunk| scope.spawn(|| add_rows(chunk)))
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().expect("an assembly thread"))
+                    .collect()
+            });
+            let mut parts = parts.into_iter();
+            let mut sum = parts.next().expect("one part at least");
+            for part in parts {
+                sum.matrix += part.matrix;
+            }
+            sum
+        };
         let mut entries = Vec::new();
-        for (k, w, range) in &self.rows {
-            entries.clear();
-            entries.extend(
-                self.entries[range.start as usize..range.end as usize]
-                    .iter()
-                    .map(|&(j, a)| (j as usize, a)),
-            );
-            system.add(&entries, w * stiffness(*k as usize));
-        }
         for row in crate::fit::smoothness_rows(layout) {
             entries.clear();
             entries.extend(
@@ -756,11 +792,14 @@ impl Normal {
         }
     }
 
-    /// Adds the row a with weight w.
+    /// Adds the row a with weight w (to the lower triangle: the factorization reads no more).
     fn add(&mut self, row: &[(usize, f64)], w: f64) {
         for &(i, a) in row {
+            let wa = w * a;
             for &(j, b) in row {
-                self.matrix[(i, j)] += w * a * b;
+                if j <= i {
+                    self.matrix[(i, j)] += wa * b;
+                }
             }
         }
     }
