@@ -678,7 +678,7 @@ proptest! {
     /// Built with tangents, the tensor stencil gives the f64 stencil's first derivatives S_u, S_v
     /// (in each row's own chart: blend gradients and transitions' chain rule included) to 1e-5 of
     /// the largest tangent, and its positions to 1e-6 of the diagonal, for any genus, degree, grid,
-    /// continuity and offset; all cores give the very same numbers.
+    /// continuity and offset; all cores, and any subset of rows, give the very same numbers.
     #[test]
     fn tensor_stencil_tangents_match_the_f64_stencil(
         genus in prop::sample::select(vec![0u32, 1, 2, 3, 5, 8, 16]),
@@ -720,6 +720,14 @@ proptest! {
         tensor.positions_and_tangents_parallel(&control, &mut all.0, &mut all.1);
         prop_assert_eq!(&all.0, &positions);
         prop_assert_eq!(&all.1, &tangents);
+        // Some rows alone, in any order, give those rows' very numbers.
+        let some: Vec<u32> = (0..n as u32).rev().step_by(3).collect();
+        let mut jets = vec![(Point3::origin(), [Vector3::zeros(); 2]); some.len()];
+        tensor.rows_positions_and_tangents(&control, &some, &mut jets);
+        for (&r, jet) in some.iter().zip(&jets) {
+            prop_assert_eq!(jet.0, positions[r as usize]);
+            prop_assert_eq!(jet.1, tangents[r as usize]);
+        }
     }
 }
 

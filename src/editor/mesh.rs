@@ -11,6 +11,7 @@ use std::ops::Range;
 use bytemuck::{Pod, Zeroable};
 use charts::{ChartId, ChartPoint};
 use embedding::brush::BrushSamples;
+use embedding::stencil::TensorStencil;
 use embedding::remesh::{QualitySettings, quality_mesh};
 use embedding::{
     ColumnIndex, ControlId, Point3, Sample, Stencil, Surface, Vector3, Wants, bounding_box,
@@ -157,6 +158,10 @@ pub struct LiveMesh {
     areas: Vec<f64>,
     outward: f64,
     size: f64,
+    /// The f32 tensor stencil with tangents, made at the first stroke brush's dab: dabs move
+    /// their vertices through it (several times faster than the f64 stencil), and the stroke's
+    /// end makes them exact again.
+    tensor: Option<TensorStencil>,
 }
 
 impl LiveMesh {
@@ -188,6 +193,7 @@ impl LiveMesh {
             areas: Vec::new(),
             outward: 1.0,
             size: 0.0,
+            tensor: None,
         };
         let all: Vec<u32> = (0..n as u32).collect();
         mesh.evaluate(surface, &all, true);
@@ -363,22 +369,22 @@ impl LiveMesh {
     }
 
     /// After a brush's dab moved `controls`: the positions and tangents of the rows they touch
-    /// anew, from the stencil (exact), on all cores. In the shaded and wireframe styles that is
-    /// all a vertex shows; in the others the colours follow too (the full evaluation).
+    /// anew, through the f32 tensor stencil (to about 1e-7 of the model's size; made at the first
+    /// call), on all cores; call [`LiveMesh::controls_changed`] with every control point a stroke
+    /// moved when it ends, to make them exact. In the shaded and wireframe styles that is all a
+    /// vertex shows; in the others the colours follow too (the exact, full evaluation).
     pub fn controls_moved(&mut self, surface: &Surface, controls: &[ControlId]) {
         let rows = self.rows_of_controls(controls);
         if matches!(self.style, Style::Curvature(_) | Style::Charts) {
             self.rows_changed(surface, &rows);
             return;
         }
-        let control = surface.control_points();
-        let stencil = &self.stencil;
+        let points = &self.tessellation.vertices;
+        let tensor = self
+            .tensor
+            .get_or_insert_with(|| TensorStencil::build_with_tangents(&surface.layout(), points));
         let mut jets = vec![(Point3::origin(), [Vector3::zeros(); 2]); rows.len()];
-        embedding::evaluate::parallel_chunks(&rows, &mut jets, |rows, out| {
-            for (o, &r) in out.iter_mut().zip(rows) {
-                *o = stencil.position_and_tangents(control, r as usize);
-            }
-        });
+        tensor.rows_positions_and_tangents(surface.control_points(), &rows, &mut jets);
         for (&r, (p, [u, v])) in rows.iter().zip(jets) {
             let r = r as usize;
             self.positions[r] = p;

@@ -500,6 +500,8 @@ impl EditorState {
         if indices.is_empty() {
             return;
         }
+        // The dabs moved the vertices through the f32 stencil: exact again.
+        self.mesh.controls_changed(&self.surface, &indices);
         let after = indices.iter().map(|c| self.control()[c.index()]).collect();
         self.history.push(
             stroke.brush.kind.name(),

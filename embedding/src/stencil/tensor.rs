@@ -246,6 +246,45 @@ impl TensorStencil {
         }
     }
 
+    /// The position and tangents of the rows `rows` alone (any order; `out[k]` is row `rows[k]`'s),
+    /// on all cores: for an edit that moved a few control points, the rows they reach.
+    ///
+    /// # Panics
+    /// If the stencil was built without tangents.
+    pub fn rows_positions_and_tangents(
+        &self,
+        control: &[Point3],
+        rows: &[u32],
+        out: &mut [(Point3, [Vector3; 2])],
+    ) {
+        assert!(self.has_tangents(), "a tensor stencil built with tangents");
+        let frame = ControlFrame::new(control);
+        let frame = &frame;
+        rows.par_chunks(ROWS_PER_TASK)
+            .zip(out.par_chunks_mut(ROWS_PER_TASK))
+            .for_each(|(rows, out)| {
+                for (o, &r) in out.iter_mut().zip(rows) {
+                    *o = match self.order {
+                        2 => self.row_jet::<2>(frame, r as usize),
+                        3 => self.row_jet::<3>(frame, r as usize),
+                        4 => self.row_jet::<4>(frame, r as usize),
+                        5 => self.row_jet::<5>(frame, r as usize),
+                        6 => self.row_jet::<6>(frame, r as usize),
+                        7 => self.row_jet::<7>(frame, r as usize),
+                        _ => self.row_jet::<8>(frame, r as usize),
+                    };
+                }
+            });
+    }
+
+    /// One row of [`TensorStencil::tangent_kernel`].
+    fn row_jet<const O: usize>(&self, frame: &ControlFrame, r: usize) -> (Point3, [Vector3; 2]) {
+        let mut position = [Point3::origin()];
+        let mut tangents = [[Vector3::zeros(); 2]];
+        self.tangent_kernel::<O>(frame, r, &mut position, &mut tangents);
+        (position[0], tangents[0])
+    }
+
     /// Per block the three sums A, B, C of the module's comment along the chart grid's lines, then
     /// the chain rule into the row's chart.
     fn tangent_kernel<const O: usize>(
