@@ -11,8 +11,8 @@ use std::ops::Range;
 use bytemuck::{Pod, Zeroable};
 use charts::{ChartId, ChartPoint};
 use embedding::brush::BrushSamples;
-use embedding::stencil::TensorStencil;
 use embedding::remesh::{QualitySettings, quality_mesh};
+use embedding::stencil::TensorStencil;
 use embedding::{
     ColumnIndex, ControlId, Point3, Sample, Stencil, Surface, Vector3, Wants, bounding_box,
     evaluate_rows,
