@@ -36,7 +36,7 @@ use num_complex::Complex64;
 
 use crate::EmbeddingError;
 use crate::spline_surface::ControlId;
-use crate::stencil::{ColumnIndex, Stencil};
+use crate::stencil::{ColumnIndex, Stencil, set_bits};
 use crate::surface::{Layout, Point3, Vector3};
 
 /// Weight of the patch terms against the blended surface's (the initial fit's default).
@@ -186,7 +186,7 @@ pub fn outward(positions: &[Point3], tangents: &[[Vector3; 2]], areas: &[f64]) -
         .iter()
         .zip(tangents)
         .zip(areas)
-        .map(|((p, [u, v]), a)| a * p.coords.dot(&u.cross(v).normalize()))
+        .map(|((p, t), a)| a * p.coords.dot(&unit_normal(*t)))
         .sum();
     if volume < 0.0 { -1.0 } else { 1.0 }
 }
@@ -245,16 +245,19 @@ fn image_weights(
     centres: &[(Point3, Vector3)],
     radius: f64,
     falloff: Falloff,
-) -> impl Iterator<Item = (usize, f64)> {
-    let f: Vec<f64> = centres
+) -> impl Iterator<Item = (usize, f64)> + '_ {
+    let at = move |c: &Point3| falloff.at((x - c).norm() / radius);
+    let norm = centres.iter().map(|(c, _)| at(c)).sum::<f64>().max(1.0);
+    centres
         .iter()
-        .map(|(c, _)| falloff.at((x - c).norm() / radius))
-        .collect();
-    let norm = f.iter().sum::<f64>().max(1.0);
-    f.into_iter()
         .enumerate()
+        .map(move |(k, (c, _))| (k, at(c) / norm))
         .filter(|&(_, w)| w > 0.0)
-        .map(move |(k, w)| (k, w / norm))
+}
+
+/// S_u × S_v made a unit vector.
+fn unit_normal([u, v]: [Vector3; 2]) -> Vector3 {
+    u.cross(&v).normalize()
 }
 
 /// One dab of a stroke brush at `centres` (the brush's centre on the surface, then its mirror
@@ -284,56 +287,46 @@ pub fn dab(
     let Some(reach) = Reach::new(samples, &only, radius)? else {
         return Ok(Vec::new());
     };
-    let normal = |r: usize| {
-        let [u, v] = samples.tangents[r];
-        u.cross(&v).normalize() * samples.outward
+    // Each image's falloff at a vertex, summed (capped at 1 where discs overlap).
+    let weight = |x: Point3| -> f64 {
+        image_weights(x, centres, radius, falloff)
+            .map(|(_, w)| w)
+            .sum()
     };
-    let planes = match kind {
-        BrushKind::Flatten => Some(planes(samples, &reach, centres, radius, falloff)),
-        _ => None,
-    };
-    let field = |r: usize| -> Vector3 {
-        let x = samples.positions[r];
-        let weights = image_weights(x, centres, radius, falloff);
-        match kind {
-            BrushKind::Grab => Vector3::zeros(),
-            BrushKind::Inflate => {
-                let w: f64 = weights.map(|(_, w)| w).sum();
-                normal(r) * (strength * STEP * radius * w)
-            }
-            BrushKind::Smooth => unreachable!("smooth is a fairing, not a field"),
-            BrushKind::Flatten => {
-                // Only the side that faces the plane's way moves (see `planes`).
-                let planes = planes.as_ref().expect("planes for flatten");
-                let [u, v] = samples.tangents[r];
-                let here = u.cross(&v).normalize();
-                weights
+    let field: Box<dyn Fn(usize) -> Vector3> = match kind {
+        BrushKind::Grab => return Err(EmbeddingError::NoDab(kind.name())),
+        BrushKind::Smooth => {
+            // How firmly each sample holds its place: 1/(s·w) − 1 for strength s and weight w
+            // (so the centre of a full-strength brush is free and the rim held), never below 0.
+            let stiffness: Vec<f64> = reach
+                .samples
+                .iter()
+                .map(|&r| {
+                    let s = (strength.abs() * weight(samples.positions[r as usize])).min(1.0);
+                    (1.0 - s) / (s + 1e-3)
+                })
+                .collect();
+            return reach.fair(samples, &stiffness);
+        }
+        BrushKind::Inflate => Box::new(move |r| {
+            unit_normal(samples.tangents[r])
+                * (samples.outward * strength * STEP * radius * weight(samples.positions[r]))
+        }),
+        BrushKind::Flatten => {
+            // Only the side that faces the plane's way moves (see `planes`).
+            let planes = planes(samples, &reach, centres, radius, falloff);
+            Box::new(move |r| {
+                let (x, here) = (samples.positions[r], unit_normal(samples.tangents[r]));
+                image_weights(x, centres, radius, falloff)
                     .map(|(k, w)| {
                         let (c, n) = planes[k];
                         let facing = here.dot(&n).max(0.0);
                         n * ((c - x.coords).dot(&n) * strength * w * facing)
                     })
                     .sum()
-            }
+            })
         }
     };
-    if kind == BrushKind::Smooth {
-        // How firmly each sample holds its place: 1/(s·w) − 1 for strength s and weight w (so the
-        // centre of a full-strength brush is free and the rim held), never below 0.
-        let stiffness: Vec<f64> = reach
-            .samples
-            .iter()
-            .map(|&r| {
-                let x = samples.positions[r as usize];
-                let w: f64 = image_weights(x, centres, radius, falloff)
-                    .map(|(_, w)| w)
-                    .sum();
-                let s = (strength.abs() * w).min(1.0);
-                (1.0 - s) / (s + 1e-3)
-            })
-            .collect();
-        return reach.fair(samples, &stiffness);
-    }
     let targets: Vec<Vector3> = reach.samples.iter().map(|&r| field(r as usize)).collect();
     reach.fit(&samples.layout, &targets)
 }
@@ -349,10 +342,7 @@ fn planes(
     radius: f64,
     falloff: Falloff,
 ) -> Vec<(Vector3, Vector3)> {
-    let unit = |r: usize| {
-        let [u, v] = samples.tangents[r];
-        u.cross(&v).normalize()
-    };
+    let unit = |r: usize| unit_normal(samples.tangents[r]);
     centres
         .iter()
         .map(|(c, _)| {
@@ -488,18 +478,11 @@ impl Reach {
                 moving[c as usize / 64] |= 1u64 << (c % 64);
             }
         }
-        let controls = bits_in_order(&moving);
+        let controls = set_bits(&moving);
         if controls.is_empty() {
             return Ok(None);
         }
-        // A bit per vertex rather than a sort: the columns of a wide brush list millions of entries.
-        let mut marks = vec![0u64; positions.len().div_ceil(64)];
-        for &c in &controls {
-            for &r in stencil.rows_of(columns, c as usize) {
-                marks[r as usize / 64] |= 1 << (r % 64);
-            }
-        }
-        let reached = bits_in_order(&marks);
+        let reached = stencil.rows_of_controls(columns, controls.iter().map(|&c| c as usize));
         // A fine tessellation has far more vertices than the spline has freedom: one in k of them
         // (about SAMPLES_PER_CONTROL per moving control point) fits the same field, each standing
         // for k vertices' area, and the press stays quick at 10⁶ vertices. Which ones is decided
@@ -749,19 +732,6 @@ impl Target for Vector3 {
     fn is_finite(&self) -> bool {
         self.iter().all(|x| x.is_finite())
     }
-}
-
-/// The indices of the set bits, in increasing order.
-fn bits_in_order(bits: &[u64]) -> Vec<u32> {
-    let mut out = Vec::new();
-    for (w, &word) in bits.iter().enumerate() {
-        let mut b = word;
-        while b != 0 {
-            out.push((w * 64) as u32 + b.trailing_zeros());
-            b &= b - 1;
-        }
-    }
-    out
 }
 
 /// A hash of a point's coordinates' magnitudes (to 2⁻³⁰ of a unit, well above rounding, far below

@@ -270,7 +270,8 @@ fn read_script(path: &Path) -> anyhow::Result<Vec<StrokeArgs>> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let words = shlex_split(line);
+        // Split at whitespace, no quoting: points and names have no spaces.
+        let words: Vec<&str> = line.split_whitespace().collect();
         let parsed = ScriptLine::try_parse_from(&words).map_err(|e| {
             let message = e.to_string();
             let first = message
@@ -289,11 +290,6 @@ fn read_script(path: &Path) -> anyhow::Result<Vec<StrokeArgs>> {
         anyhow::bail!("{}: the script has no strokes", path.display());
     }
     Ok(strokes)
-}
-
-/// Splits a script line into words at whitespace (no quoting: points and names have no spaces).
-fn shlex_split(line: &str) -> Vec<String> {
-    line.split_whitespace().map(str::to_string).collect()
 }
 
 /// Applies one stroke to the editor's state.

@@ -209,24 +209,10 @@ impl DragPlan {
         touched.sort_unstable_by_key(|t| t.0);
         plan.touched = touched.iter().map(|t| t.0).collect();
         plan.beta = touched.iter().map(|t| t.1).collect();
-        // The rows reached: a bit per vertex, set from the touched columns (small enough to stay in
-        // cache), read in increasing order.
-        let n = mesh.vertex_count();
-        let mut marks = vec![0u64; n.div_ceil(64)];
-        for &c in &plan.touched {
-            for &r in mesh.stencil().rows_of(mesh.columns(), c.index()) {
-                marks[r as usize / 64] |= 1 << (r % 64);
-            }
-        }
-        plan.rows = marks
-            .iter()
-            .enumerate()
-            .flat_map(|(w, &bits)| {
-                (0..64u32)
-                    .filter(move |b| bits & (1u64 << b) != 0)
-                    .map(move |b| (w * 64) as u32 + b)
-            })
-            .collect();
+        // The rows reached, in increasing order.
+        plan.rows = mesh
+            .stencil()
+            .rows_of_controls(mesh.columns(), plan.touched.iter().map(|c| c.index()));
         // Each reached row's gains from its own stencil row (streamed, in parallel), with β looked up
         // by control point.
         let mut beta = vec![Vector3::zeros(); control.len()];

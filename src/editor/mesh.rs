@@ -150,8 +150,6 @@ pub struct LiveMesh {
     style: Style,
     /// The curvature style's colour range (kept during edits so colours stay comparable).
     curvature_range: Option<f64>,
-    /// Scratch: a mark per vertex.
-    marks: Vec<u64>,
     /// The vertices' areas and the normal's orientation, for brushes: as of the last
     /// [`LiveMesh::refresh_brush_weights`] (they weight a brush's samples; an edit changes them a
     /// little, so a stroke's dabs use the areas of its start).
@@ -189,7 +187,6 @@ impl LiveMesh {
             bvh_stale: true,
             style,
             curvature_range: None,
-            marks: vec![0; n.div_ceil(64)],
             areas: Vec::new(),
             outward: 1.0,
             size: 0.0,
@@ -349,23 +346,10 @@ impl LiveMesh {
         self.dirty.all = true;
     }
 
-    /// The rows any of `controls` touches, in increasing order (marked in a bitmap, read out in
-    /// order: no sort).
-    pub fn rows_of_controls(&mut self, controls: &[ControlId]) -> Vec<u32> {
-        for &c in controls {
-            for &r in self.stencil.rows_of(&self.columns, c.index()) {
-                self.marks[r as usize / 64] |= 1u64 << (r % 64);
-            }
-        }
-        let mut rows = Vec::new();
-        for (w, bits) in self.marks.iter_mut().enumerate() {
-            let mut b = std::mem::take(bits);
-            while b != 0 {
-                rows.push((w * 64) as u32 + b.trailing_zeros());
-                b &= b - 1;
-            }
-        }
-        rows
+    /// The rows any of `controls` touches, in increasing order.
+    pub fn rows_of_controls(&self, controls: &[ControlId]) -> Vec<u32> {
+        self.stencil
+            .rows_of_controls(&self.columns, controls.iter().map(|c| c.index()))
     }
 
     /// After a brush's dab moved `controls`: the positions and tangents of the rows they touch

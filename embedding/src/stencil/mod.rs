@@ -125,6 +125,23 @@ impl Stencil {
         &index.rows[index.offsets[control]..index.offsets[control + 1]]
     }
 
+    /// The rows that any of `controls` touches, in increasing order: a bit per row set from their
+    /// columns and read out in order (the columns of a wide edit list millions of entries; no
+    /// sort).
+    pub fn rows_of_controls(
+        &self,
+        index: &ColumnIndex,
+        controls: impl IntoIterator<Item = usize>,
+    ) -> Vec<u32> {
+        let mut marks = vec![0u64; self.rows().div_ceil(64)];
+        for c in controls {
+            for &r in self.rows_of(index, c) {
+                marks[r as usize / 64] |= 1u64 << (r % 64);
+            }
+        }
+        set_bits(&marks)
+    }
+
     /// S_u and S_v (in each point's own chart) = W_u · control, W_v · control.
     pub fn derivatives(&self, control: &[Point3], du: &mut [Vector3], dv: &mut [Vector3]) {
         for r in 0..self.rows() {
@@ -188,4 +205,17 @@ impl Stencil {
             positions[index.rows[k] as usize] += delta * self.pos[index.entries[k]];
         }
     }
+}
+
+/// The indices of the set bits of `bits`, in increasing order.
+pub(crate) fn set_bits(bits: &[u64]) -> Vec<u32> {
+    let mut out = Vec::new();
+    for (w, &word) in bits.iter().enumerate() {
+        let mut b = word;
+        while b != 0 {
+            out.push((w * 64) as u32 + b.trailing_zeros());
+            b &= b - 1;
+        }
+    }
+    out
 }
