@@ -384,6 +384,9 @@ fn key(p: P2) -> (u64, u64) {
     (p[0].to_bits(), p[1].to_bits())
 }
 
+/// Triangles smaller than this fraction of the target area are not refined further.
+const MIN_AREA_FRACTION: f64 = 0.05;
+
 /// Meshes the plan in the plane (constrained Delaunay, refined) and lifts it.
 fn build(plan: &Plan, h: f64, genus: u32, resolution: usize) -> Result<HoledMesh, EmbeddingError> {
     let fail = |what: String| EmbeddingError::Parameterization(what);
@@ -428,6 +431,11 @@ fn build(plan: &Plan, h: f64, genus: u32, resolution: usize) -> Result<HoledMesh
             .keep_constraint_edges()
             .with_angle_limit(spade::AngleLimit::from_deg(20.0))
             .with_max_allowed_area(1.5 * area)
+            // The 4n loop ends leave p₀ at angles 2π/4n apart, below the angle limit from genus
+            // 5 on; refining there cascades into ever smaller triangles (edges of 4e-8 at genus
+            // 16, where the map then folded). The thin triangles of the fan round p₀ are
+            // harmless; their refinement stops at a twentieth of the target area.
+            .with_min_required_area(MIN_AREA_FRACTION * area)
             // The lifted mesh has about four triangles per plan vertex, so a mesh the fit takes
             // never needs more; this bounds the meshing's own memory for resolutions it refuses.
             .with_max_additional_vertices(crate::fit::MAX_FIT_TRIANGLES),

@@ -27,6 +27,7 @@ pub mod edit;
 pub mod evaluate;
 pub mod fit;
 pub mod floater;
+pub mod harmonic;
 pub mod holed;
 pub mod integrals;
 pub mod mesh_fit;

@@ -37,6 +37,7 @@ use crate::fit::{
     FitSettings, FitStage, Lifts, Parameterization, RELAX_TOLERANCE, deepest, diagonal, fit,
     stereographic_points, vertex_areas,
 };
+use crate::harmonic::Convergence;
 use crate::sphere_map::{EXTRA_ROUNDS, sphere_map};
 use crate::spline_surface::Surface;
 use crate::surface::{Layout, Point3, SplineSettings};
@@ -138,6 +139,7 @@ pub fn mesh_model(
             copies: Vec::new(),
             folded: mapped.folded,
             sweeps: mapped.sweeps,
+            newton: mapped.solved,
         },
         loops: mapped.loops,
         rms_residual: (sum / positions.len() as f64).sqrt(),
@@ -153,6 +155,8 @@ struct Mapped {
     lifts: Vec<Complex64>,
     folded: usize,
     sweeps: usize,
+    /// Newton's solve of the polygon's map (none for the sphere's).
+    solved: Option<Convergence>,
     loops: LoopReport,
 }
 
@@ -183,6 +187,7 @@ fn map_to_sphere(
         lifts: Vec::new(),
         folded: map.folded,
         sweeps: map.sweeps,
+        solved: None,
         loops: LoopReport {
             base: 0,
             paths: Vec::new(),
@@ -215,15 +220,15 @@ fn map_to_polygon(
         mut lifts,
     } = best_marking(he, positions, triangles, areas, polygon, &length)?;
     let rounds = fit_settings.stretch_rounds + 1;
-    let mut sweeps = 0;
-    for round in 1..=rounds {
+    progress(FitStage::Relaxing { round: 1, rounds });
+    let mut solved = lifts.settle(hyperbolic)?;
+    for round in 2..=rounds {
         progress(FitStage::Relaxing { round, rounds });
-        if round > 1 {
-            let stretch = lifts.stretch(positions, hyperbolic);
-            lifts.reweight(&stretch);
-        }
-        sweeps += lifts.relax(hyperbolic, fit_settings.sweeps, RELAX_TOLERANCE);
+        let stretch = lifts.stretch(positions, hyperbolic);
+        lifts.reweight(&stretch);
+        solved = solved.then(lifts.settle(hyperbolic)?);
     }
+    let sweeps = solved.sweeps;
     let folded = lifts.folded_triangles(hyperbolic);
     let points = lifts
         .home
@@ -244,6 +249,7 @@ fn map_to_polygon(
         lifts: lifts.home,
         folded,
         sweeps,
+        solved: Some(solved),
         loops,
     })
 }

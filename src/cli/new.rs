@@ -183,8 +183,14 @@ pub struct NewReport {
     pub mesh_vertices: usize,
     pub mesh_triangles: usize,
     pub control_points: usize,
-    /// Relaxation sweeps of the parameterization, and triangles it folds (0: a bijection).
+    /// Gauss–Seidel sweeps of the parameterization (the sphere's whole relaxation, or the polygon
+    /// map's warm-up), Newton's solve of the polygon's map, and triangles the map folds (0: a
+    /// bijection).
     pub sweeps: usize,
+    pub newton: Option<embedding::harmonic::Convergence>,
+    /// How far the map onto the polygon is from conformal and area-preserving (plates only: it is
+    /// measured on their cut disk).
+    pub distortion: Option<embedding::fit::Distortion>,
     pub folded_triangles: usize,
     /// |S(p_i) − P_i| over the mesh vertices, as fractions of the mesh's bounding-box diagonal.
     pub rms_residual: f64,
@@ -299,6 +305,11 @@ pub fn check(
         mesh_triangles: triangles.len(),
         control_points: surface.control_points().len(),
         sweeps: parameterization.sweeps,
+        newton: parameterization.newton,
+        distortion: surface
+            .atlas()
+            .polygon()
+            .and_then(|p| parameterization.distortion(positions, p.geometry())),
         folded_triangles: parameterization.folded,
         rms_residual: rms_residual / mesh_diagonal,
         max_residual: max_residual / mesh_diagonal,
@@ -363,6 +374,27 @@ pub fn make(
 }
 
 impl NewReport {
+    /// How the map was solved, in words.
+    fn solve_text(&self) -> String {
+        match self.newton {
+            None => format!("{} relaxation sweeps", self.sweeps),
+            Some(n) => format!(
+                "{} sweeps and {} Newton steps ({} factorizations, residual {:.0e})",
+                self.sweeps, n.steps, n.factorizations, n.residual
+            ),
+        }
+    }
+
+    /// The map's distortion as a line of its own, where measured.
+    fn distortion_text(&self) -> String {
+        self.distortion.map_or(String::new(), |d| {
+            format!(
+                "\nmap distortion: angles (σ₁/σ₂) {:.2} mean, {:.2} max; areas ×{:.2} mean, ×{:.2} max",
+                d.angle_mean, d.angle_max, d.area_mean, d.area_max
+            )
+        })
+    }
+
     /// The human-readable form (without the line saying where the model went).
     pub fn to_text(&self) -> String {
         let verdict = |ok: bool| if ok { "ok" } else { "FAILED" };
@@ -370,7 +402,7 @@ impl NewReport {
             "genus {genus}: degree {degree}, C^{cont} blends, {grid}×{grid} control grid per chart, \
              {controls} control points\n\
              input mesh: {v} vertices, {f} triangles, bounding-box diagonal {diag:.3}\n\
-             parameterization: {sweeps} relaxation sweeps, {folded} folded triangles ({bij})\n\
+             parameterization: {solve}, {folded} folded triangles ({bij}){distortion}\n\
              fit residual: rms {rms:.3}%, max {max:.3}% of the diagonal ({res})\n\
              Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, relative error {gb:.1e} ({gbv})\n\
              shape: patches disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%), \
@@ -384,7 +416,8 @@ impl NewReport {
             v = self.mesh_vertices,
             f = self.mesh_triangles,
             diag = self.diagonal,
-            sweeps = self.sweeps,
+            solve = self.solve_text(),
+            distortion = self.distortion_text(),
             folded = self.folded_triangles,
             bij = verdict(self.folded_triangles == 0),
             rms = 100.0 * self.rms_residual,

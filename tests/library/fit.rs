@@ -85,7 +85,7 @@ fn lifted_areas(genus: u32, resolution: usize) -> (Vec<f64>, usize, usize) {
     let atlas = Atlas::new(genus).unwrap();
     let mesh = HoledMesh::new(genus, resolution).unwrap();
     let s = FitSettings::default();
-    let p = parameterize(&atlas, &mesh, s.sweeps, s.stretch_rounds).unwrap();
+    let p = parameterize(&atlas, &mesh, s.stretch_rounds).unwrap();
     let disk = p.disk.as_ref().unwrap();
     let klein_flips = disk
         .triangles
@@ -140,7 +140,7 @@ fn the_parameterization_is_a_bijection_for_genus_1_to_8() {
 fn the_sphere_is_parameterized_stereographically() {
     let atlas = Atlas::new(0).unwrap();
     let mesh = HoledMesh::new(0, 24).unwrap();
-    let p = parameterize(&atlas, &mesh, 0, 0).unwrap();
+    let p = parameterize(&atlas, &mesh, 0).unwrap();
     // Every vertex lands well inside a cap, and the caps' images agree with the 3D directions.
     for (point, x) in p.points.iter().zip(&mesh.positions) {
         let z = atlas.to_model(*point).unwrap().0;
@@ -258,4 +258,119 @@ fn the_fit_reports_its_stages_in_order() {
         expected.push(FitStage::Fitting);
         assert_eq!(seen.into_inner(), expected, "genus {genus}");
     }
+}
+
+/// The plate's meshing keeps its triangles whole at every genus: refining round p₀, where the 4n
+/// loop ends meet at angles 2π/4n, once cascaded into triangles with edges of 4e-8 (genus 16),
+/// and the map folded there.
+#[test]
+fn plates_have_no_sliver_triangles_up_to_genus_64() {
+    for genus in [2, 5, 8, 12, 16, 24, 32, 48, 64] {
+        let resolution = 8;
+        let mesh = HoledMesh::new(genus, resolution).unwrap();
+        // The holes have radius 0.5; the target edge length is their circumference / resolution.
+        let h = std::f64::consts::TAU * 0.5 / resolution as f64;
+        let smallest = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+                (b - a).cross(&(c - a)).norm() / 2.0
+            })
+            .fold(f64::INFINITY, f64::min);
+        // Measured after the fix: ≥ 3.7e-5 h² (genus 8); before it, 5e-30 h² at genus 16.
+        assert!(
+            smallest > 1e-5 * h * h,
+            "genus {genus}: a triangle of area {smallest:e} (target {:e})",
+            3f64.sqrt() / 4.0 * h * h
+        );
+    }
+}
+
+/// The map from genus 1 to 16 is solved (Newton's residual below the tolerance) and folds nothing.
+#[test]
+fn the_map_converges_without_folds_up_to_genus_16() {
+    for genus in [1, 2, 4, 9, 16] {
+        let atlas = Atlas::new(genus).unwrap();
+        let mesh = HoledMesh::new(genus, 8).unwrap();
+        let p = parameterize(&atlas, &mesh, FitSettings::default().stretch_rounds).unwrap();
+        let newton = p
+            .newton
+            .expect("the polygon's map is solved by Newton's method");
+        assert!(
+            newton.residual <= embedding::fit::RELAX_TOLERANCE,
+            "genus {genus}: {newton:?}"
+        );
+        assert_eq!(p.folded, 0, "genus {genus}");
+        let geometry = atlas.polygon().unwrap().geometry();
+        let d = p.distortion(&mesh.positions, geometry).unwrap();
+        assert!(
+            d.angle_mean.is_finite() && d.area_max.is_finite(),
+            "genus {genus}: {d:?}"
+        );
+    }
+}
+
+/// The distortion of maps whose answer is known: a planar disk mapped by a linear map A has σ₁/σ₂
+/// of A on every triangle and no area distortion (areas are relative to the whole map's ratio);
+/// doubling the map's size in one half doubles (and halves) relative areas there.
+#[test]
+fn distortion_measures_known_maps() {
+    // A 12 × 12 grid of squares, each split in two, in the unit square.
+    let n = 12u32;
+    let at = |i: u32, j: u32| i + (n + 1) * j;
+    let mut triangles = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let plane: Vec<embedding::Point3> = (0..=n)
+        .flat_map(|j| {
+            (0..=n)
+                .map(move |i| embedding::Point3::new(f64::from(i) / 12.0, f64::from(j) / 12.0, 0.0))
+        })
+        .collect();
+    let disk = embedding::fit::CutDisk {
+        original: (0..plane.len() as u32).collect(),
+        triangles,
+        boundary: Vec::new(),
+        arcs: Vec::new(),
+    };
+    let map = |f: &dyn Fn(f64, f64) -> num_complex::Complex64| embedding::fit::Parameterization {
+        points: Vec::new(),
+        disk: Some(disk.clone()),
+        flat: Vec::new(),
+        lifts: Vec::new(),
+        copies: plane.iter().map(|p| f(p.x, p.y)).collect(),
+        folded: 0,
+        sweeps: 0,
+        newton: None,
+    };
+    for (a, b, c, d) in [
+        (2.0, 0.0, 0.0, 1.0),
+        (1.0, 0.7, -0.2, 1.5),
+        (0.3, -1.0, 1.0, 0.3),
+    ] {
+        let p = map(&|x, y| num_complex::Complex64::new(a * x + b * y, c * x + d * y));
+        let got = p.distortion(&plane, Geometry::Euclidean).unwrap();
+        // σ₁/σ₂ of [[a, b], [c, d]].
+        let (frob, det) = (a * a + b * b + c * c + d * d, a * d - b * c);
+        let root = (frob * frob / 4.0 - det * det).max(0.0).sqrt();
+        let want = ((frob / 2.0 + root) / (frob / 2.0 - root)).sqrt();
+        for value in [got.angle_mean, got.angle_max] {
+            assert!((value - want).abs() < 1e-9, "{value} against {want}");
+        }
+        assert!(
+            (got.area_mean - 1.0).abs() < 1e-9 && (got.area_max - 1.0).abs() < 1e-9,
+            "{got:?}"
+        );
+    }
+    // x ↦ 2x for x > ½ (continuous at ½): areas there double, so relative to the mean ratio 3/2
+    // they are ×4/3 and ×2/3 (factor 3/2 either way).
+    let p = map(&|x, y| num_complex::Complex64::new(if x > 0.5 { 2.0 * x - 0.5 } else { x }, y));
+    let got = p.distortion(&plane, Geometry::Euclidean).unwrap();
+    assert!((got.area_max - 1.5).abs() < 1e-9, "{got:?}");
+    assert!((got.angle_max - 2.0).abs() < 1e-9, "{got:?}");
 }
