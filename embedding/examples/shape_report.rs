@@ -24,8 +24,17 @@ fn main() {
     );
     for genus in genera {
         let start = Instant::now();
-        let fit = initial_model(genus, 32, SplineSettings::default(), FitSettings::default())
-            .expect("the fit");
+        // NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override the defaults, for tuning.
+        let defaults = FitSettings::default();
+        let setting = |name: &str, default: f64| {
+            std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
+        };
+        let settings = FitSettings {
+            patch_weight: setting("NTORI_PATCH_WEIGHT", defaults.patch_weight),
+            smoothness: setting("NTORI_SMOOTHNESS", defaults.smoothness),
+            ..defaults
+        };
+        let fit = initial_model(genus, 32, SplineSettings::default(), settings).expect("the fit");
         let seconds = start.elapsed().as_secs_f64();
         let s = &fit.surface;
         let points = sample_points(s, 32).expect("a tessellation");
@@ -37,6 +46,7 @@ fn main() {
             &fit.mesh.positions,
             &fit.mesh.triangles,
         );
+        let flat = flat_faces(&fit);
         println!(
             "{genus:5}  {seconds:6.1}  {:8.3}% {:8.3}%                        {:7.2}  {:6.2} {:6.2} {:6.2}",
             100.0 * d.max / fit.mesh_diagonal,
@@ -46,5 +56,56 @@ fn main() {
             n.p90,
             n.max
         );
+        if let Some((p90, h_median, h_p90, count)) = flat {
+            println!(
+                "       flat faces ({count} vertices): normal off ±z by {p90:.2}° (90%), |H|·T {h_median:.4} median, {h_p90:.4} (90%)"
+            );
+        }
     }
+}
+
+/// On the plate's flat faces (input vertices at height ±T, away from the rims' bands) the intended
+/// normal is ±z and the mean curvature 0: the 90th percentile of the surface normal's angle from ±z,
+/// and of |H|·T (median, 90%), over those vertices. `None` for the sphere and the torus.
+fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)> {
+    const THICKNESS: f64 = 0.35;
+    if fit.surface.genus() < 2 {
+        return None;
+    }
+    let flat: Vec<usize> = (0..fit.mesh.positions.len())
+        .filter(|&i| (fit.mesh.positions[i].z.abs() - THICKNESS).abs() < 1e-12)
+        .collect();
+    let points: Vec<_> = flat
+        .iter()
+        .map(|&i| fit.parameterization.points[i])
+        .collect();
+    let mut angles = vec![180.0; flat.len()];
+    let mut curvatures = vec![f64::INFINITY; flat.len()];
+    embedding::evaluate::evaluate(
+        &fit.surface,
+        &points,
+        embedding::evaluate::Wants {
+            curvature: true,
+            ..Default::default()
+        },
+        0.0,
+        &mut |s: &embedding::evaluate::Sample| {
+            if let Some(n) = s.normal {
+                angles[s.index] = n.z.abs().min(1.0).acos().to_degrees();
+            }
+            if let Some(c) = s.curvature {
+                curvatures[s.index] = c.mean.abs() * THICKNESS;
+            }
+        },
+    );
+    let quantile = |v: &mut Vec<f64>, q: f64| {
+        v.sort_by(f64::total_cmp);
+        v[((v.len() - 1) as f64 * q) as usize]
+    };
+    Some((
+        quantile(&mut angles, 0.9),
+        quantile(&mut curvatures, 0.5),
+        quantile(&mut curvatures, 0.9),
+        flat.len(),
+    ))
 }
