@@ -225,8 +225,8 @@ pub struct InitialFit {
 /// factorizations dominate. Rounded up.
 pub const FIT_BYTES_PER_TRIANGLE: u64 = 21_000;
 /// The most input triangles [`initial_model`] fits: about 4.2 GB at the rate above. Genus 16 at
-/// resolution 32 (155 820 triangles) is within the cap; genus 64 makes 1.8 million even at
-/// resolution 8, so no genus-64 fit is possible on this path.
+/// resolution 32 (115 384 triangles) is within the cap; genus 64 exceeds it even at resolution 8,
+/// so no genus-64 fit is possible on this path.
 pub const MAX_FIT_TRIANGLES: usize = 200_000;
 
 /// A stage of [`initial_model_with_progress`], for progress displays.
