@@ -24,7 +24,7 @@ fn main() {
     );
     for genus in genera {
         let start = Instant::now();
-        // NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override the defaults, for tuning.
+        // NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override the fit's defaults, for tuning.
         let defaults = FitSettings::default();
         let setting = |name: &str, default: f64| {
             std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
@@ -32,9 +32,16 @@ fn main() {
         let settings = FitSettings {
             patch_weight: setting("NTORI_PATCH_WEIGHT", defaults.patch_weight),
             smoothness: setting("NTORI_SMOOTHNESS", defaults.smoothness),
+            stretch_rounds: setting("NTORI_STRETCH_ROUNDS", defaults.stretch_rounds as f64) as usize,
             ..defaults
         };
-        let fit = initial_model(genus, 32, SplineSettings::default(), settings).expect("the fit");
+        // NTORI_GRID overrides the spline grid.
+        let spline = SplineSettings {
+            grid: setting("NTORI_GRID", SplineSettings::default().grid as f64) as usize,
+            ..SplineSettings::default()
+        };
+        let resolution = setting("NTORI_RESOLUTION", 32.0) as usize;
+        let fit = initial_model(genus, resolution, spline, settings).expect("the fit");
         let seconds = start.elapsed().as_secs_f64();
         let s = &fit.surface;
         let points = sample_points(s, 32).expect("a tessellation");
