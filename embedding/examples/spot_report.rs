@@ -1,0 +1,55 @@
+//! Where a model's largest principal curvature sits and what makes it: the blend weights there, and
+//! each chart's own patch (position, |E_u × E_v| and the angle between E_u and E_v, by differences
+//! in that chart's coordinates). `cargo run --release -p embedding --example spot_report MODEL.json`
+use charts::ChartPoint;
+use embedding::Surface;
+use embedding::quality::{max_principal_curvature, sample_points};
+use num_complex::Complex64;
+
+fn main() {
+    let path = std::env::args().nth(1).expect("a model file");
+    let text = std::fs::read_to_string(&path).expect("readable");
+    let model: embedding::model::Model = serde_json::from_str(&text).expect("a model");
+    let surface = Surface::from_model(&model).expect("a surface");
+    let points = sample_points(&surface, 32).expect("a tessellation");
+    let k = max_principal_curvature(&surface, &points);
+    let at = k.at.expect("a point");
+    let layout = surface.layout();
+    let control = surface.control_points();
+    let jet = layout.eval(control, at);
+    println!(
+        "max |κ| {:.2} at chart {:?} {:.4}: position {:.4?}, area element {:.3e}, normal {:.3?}",
+        k.max_abs,
+        at.chart,
+        at.coords,
+        jet.pos,
+        jet.area_element(),
+        jet.normal()
+    );
+    let blends = layout.blends(at);
+    let own = |p: ChartPoint| {
+        let mut basis = Vec::new();
+        layout.patch_weights(p, &mut basis);
+        basis
+            .iter()
+            .fold(embedding::Vector3::zeros(), |s, &(c, v)| s + control[c as usize].coords * v)
+    };
+    for (rep, _) in surface.atlas().locate_with_transitions(at) {
+        let b = blends.iter().find(|b| b.0 == rep.chart).map_or(0.0, |b| b.1);
+        let h = 1e-5;
+        let e = own(rep);
+        let shift = |d: Complex64| own(ChartPoint::new(rep.chart, rep.coords + d));
+        let eu = (shift(Complex64::new(h, 0.0)) - shift(Complex64::new(-h, 0.0))) / (2.0 * h);
+        let ev = (shift(Complex64::new(0.0, h)) - shift(Complex64::new(0.0, -h))) / (2.0 * h);
+        let angle = (eu.dot(&ev) / (eu.norm() * ev.norm())).acos().to_degrees();
+        println!(
+            "  chart {:?} at {:.4}: blend {b:.4}, patch {:.4?} (off the surface by {:.2e}), |E_u| {:.3e}, |E_v| {:.3e}, angle(E_u, E_v) {angle:.2}°",
+            rep.chart,
+            rep.coords,
+            e,
+            (e - jet.pos.coords).norm(),
+            eu.norm(),
+            ev.norm()
+        );
+    }
+}
