@@ -32,7 +32,8 @@ fn main() {
         let settings = FitSettings {
             patch_weight: setting("NTORI_PATCH_WEIGHT", defaults.patch_weight),
             smoothness: setting("NTORI_SMOOTHNESS", defaults.smoothness),
-            stretch_rounds: setting("NTORI_STRETCH_ROUNDS", defaults.stretch_rounds as f64) as usize,
+            stretch_rounds: setting("NTORI_STRETCH_ROUNDS", defaults.stretch_rounds as f64)
+                as usize,
             ..defaults
         };
         // NTORI_GRID overrides the spline grid.

@@ -32,10 +32,15 @@ fn main() {
         layout.patch_weights(p, &mut basis);
         basis
             .iter()
-            .fold(embedding::Vector3::zeros(), |s, &(c, v)| s + control[c as usize].coords * v)
+            .fold(embedding::Vector3::zeros(), |s, &(c, v)| {
+                s + control[c as usize].coords * v
+            })
     };
     for (rep, _) in surface.atlas().locate_with_transitions(at) {
-        let b = blends.iter().find(|b| b.0 == rep.chart).map_or(0.0, |b| b.1);
+        let b = blends
+            .iter()
+            .find(|b| b.0 == rep.chart)
+            .map_or(0.0, |b| b.1);
         let h = 1e-5;
         let e = own(rep);
         let shift = |d: Complex64| own(ChartPoint::new(rep.chart, rep.coords + d));

@@ -714,7 +714,10 @@ mod tests {
             let (x0, z0) = profile.at(0.0);
             let (x1, z1) = profile.at(1.0);
             assert!(x0.abs() < 1e-15 && z0.abs() < 1e-15, "{profile:?}");
-            assert!((x1 - 1.0).abs() < 1e-13 && (z1 - 1.0).abs() < 1e-13, "{profile:?}");
+            assert!(
+                (x1 - 1.0).abs() < 1e-13 && (z1 - 1.0).abs() < 1e-13,
+                "{profile:?}"
+            );
         }
     }
 

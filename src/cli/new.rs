@@ -7,7 +7,7 @@ use anyhow::Context as _;
 use charts::ChartPoint;
 use embedding::fit::{FitSettings, InitialFit, initial_model_with_progress};
 use embedding::holed::HoledMesh;
-use embedding::integrals::surface_integrals;
+use embedding::integrals::{cells_per_knot, surface_integrals};
 use embedding::{SplineSettings, Surface};
 use ntori::io::export::{self, ExportOptions, Format};
 use serde::Serialize;
@@ -285,7 +285,9 @@ pub fn check(
         smoothness,
     } = *fitted;
     stage("integrating the curvature");
-    let sums = surface_integrals(&surface.layout(), surface.control_points(), 8);
+    let layout = surface.layout();
+    let cells = cells_per_knot(layout.settings());
+    let sums = surface_integrals(&layout, surface.control_points(), cells);
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
     let curvature_error =
         (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
