@@ -820,10 +820,10 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
     };
     assert_eq!(
         grid(&harness),
-        Some(16.0),
+        Some(SplineSettings::default().grid as f64),
         "the grid field follows the undo"
     );
-    assert!(harness.state().state().unwrap().settings().grid == 16);
+    assert!(harness.state().state().unwrap().settings().grid == SplineSettings::default().grid);
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     harness.run();
     assert_eq!(harness.state().state().unwrap().settings().grid, 12);

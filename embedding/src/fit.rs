@@ -1098,12 +1098,13 @@ pub fn fit(
             triplets.extend((0..cols).map(|c| Triplet::new(rows + c, c, EPSILON)));
             let mut padded = Mat::<f64>::zeros(rows + cols, 3);
             padded.as_mut().subrows_mut(0, rows).copy_from(&rhs);
-            least_squares(rows + cols, cols, &triplets, &padded)?.ok_or_else(|| {
-                EmbeddingError::Parameterization(format!(
-                    "the sparse least-squares solver failed on {rows} rows and {cols} control \
-                     points; lower the grid or raise the mesh resolution"
-                ))
-            })?
+            match least_squares(rows + cols, cols, &triplets, &padded)? {
+                Some(x) => x,
+                // Measured: the editor's refit of a genus-2 model to grid 34 (309 738 rows) fails
+                // both ways. The normal equations square the condition number, but the
+                // smoothness rows keep it far from f64's limit, and sparse LU does not fail here.
+                None => normal_equations(rows + cols, cols, &triplets, &padded)?,
+            }
         }
     };
     let control: Vec<Point3> = (0..cols)
@@ -1139,6 +1140,40 @@ pub(crate) fn least_squares(
         ))),
         Err(_) => Ok(None),
     }
+}
+
+/// The least-squares solution of A x = rhs through the normal equations AᵀA x = Aᵀ rhs, by sparse
+/// LU: the last resort where faer's sparse QR failed (see [`fit`]).
+fn normal_equations(
+    rows: usize,
+    cols: usize,
+    triplets: &[Triplet<usize, usize, f64>],
+    rhs: &Mat<f64>,
+) -> Result<Mat<f64>, EmbeddingError> {
+    let failed = |what: String| {
+        EmbeddingError::Parameterization(format!(
+            "the sparse least-squares solver failed on {rows} rows and {cols} control points \
+             ({what}); lower the grid or raise the mesh resolution"
+        ))
+    };
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, triplets)
+        .map_err(|e| failed(format!("{e:?}")))?;
+    let transposed: Vec<_> = triplets
+        .iter()
+        .map(|t| Triplet::new(t.col, t.row, t.val))
+        .collect();
+    let at = SparseColMat::<usize, f64>::try_new_from_triplets(cols, rows, &transposed)
+        .map_err(|e| failed(format!("{e:?}")))?;
+    let gram = faer::sparse::linalg::matmul::sparse_sparse_matmul(
+        at.as_ref(),
+        a.as_ref(),
+        1.0,
+        faer::Par::Seq,
+    )
+    .map_err(|e| failed(format!("{e:?}")))?;
+    let projected = at.as_ref() * rhs.as_ref();
+    let lu = gram.sp_lu().map_err(|e| failed(format!("{e:?}")))?;
+    Ok(lu.solve(&projected))
 }
 
 thread_local! {
