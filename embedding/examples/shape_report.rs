@@ -1,12 +1,13 @@
 //! Issue 12's shape measures for the default fit at several genera: patch disagreement (as a
 //! fraction of the mesh diagonal), the largest principal curvature, and the normal deviation from
-//! the input mesh at its vertices. `cargo run --release -p embedding --example shape_report [GENERA…]`
+//! the intended shape at the input mesh's vertices.
+//! `cargo run --release -p embedding --example shape_report [GENERA…]`
 use std::time::Instant;
 
 use embedding::SplineSettings;
 use embedding::fit::{FitSettings, initial_model};
 use embedding::quality::{
-    max_principal_curvature, normal_deviation, patch_disagreement, sample_points,
+    max_principal_curvature, normal_deviation_from, patch_disagreement, sample_points,
 };
 
 fn main() {
@@ -20,7 +21,7 @@ fn main() {
         genera
     };
     println!(
-        "genus  fit(s)  disagreement(max, rms; % of diagonal)  max|κ|   normal deviation (median, p90, max; degrees)"
+        "genus  fit(s)  disagreement(max, rms; % of diagonal)  max|κ|   normal deviation from the intended shape (median, p90, max; degrees)"
     );
     for genus in genera {
         let start = Instant::now();
@@ -48,12 +49,7 @@ fn main() {
         let points = sample_points(s, 32).expect("a tessellation");
         let d = patch_disagreement(s, &points, 0.1);
         let k = max_principal_curvature(s, &points);
-        let n = normal_deviation(
-            s,
-            &fit.parameterization.points,
-            &fit.mesh.positions,
-            &fit.mesh.triangles,
-        );
+        let n = normal_deviation_from(s, &fit.parameterization.points, &fit.mesh.normals);
         let flat = flat_faces(&fit);
         println!(
             "{genus:5}  {seconds:6.1}  {:8.3}% {:8.3}%                        {:7.2}  {:6.2} {:6.2} {:6.2}",

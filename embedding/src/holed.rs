@@ -33,7 +33,7 @@ use std::f64::consts::{PI, TAU};
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 use crate::EmbeddingError;
-use crate::surface::Point3;
+use crate::surface::{Point3, Vector3};
 
 /// Largest genus the generator builds (the atlas's limit).
 pub const MAX_GENUS: u32 = charts::MAX_GENUS;
@@ -51,6 +51,10 @@ pub struct HoledMesh {
     pub base: u32,
     /// Half the plate's thickness: the plate lies in |z| ≤ `thickness`.
     pub thickness: f64,
+    /// The intended surface's unit outward normal at each vertex: exact, not estimated from the
+    /// triangles, so a fitted surface's normals can be measured against the shape itself rather
+    /// than against the mesh's facets.
+    pub normals: Vec<Vector3>,
 }
 
 /// A point of the plan (the plate seen from above).
@@ -426,6 +430,37 @@ impl Plan {
     }
 }
 
+impl Plan {
+    /// The unit outward normal of the lifted surface at the lift of `q`: +z (or −z) on the flat
+    /// faces; in a band, the profile's normal (sin φ across the circle, cos φ up), since the lift
+    /// moves a point straight across its nearest circle.
+    fn normal(&self, q: P2, side: Side) -> Vector3 {
+        let nearest = self
+            .circles
+            .iter()
+            .min_by(|a, b| a.depth(q).total_cmp(&b.depth(q)))
+            .expect("a plan has at least one circle");
+        let d = nearest.depth(q).max(0.0);
+        let up = match side {
+            Side::Top => 1.0,
+            Side::Bottom => -1.0,
+        };
+        if d >= self.band {
+            return Vector3::new(0.0, 0.0, up);
+        }
+        let phi = self.profile.angle(1.0 - d / self.band);
+        let (dx, dy) = (q[0] - nearest.centre[0], q[1] - nearest.centre[1]);
+        let r = dx.hypot(dy);
+        let (ux, uy) = if r > 0.0 {
+            (dx / r, dy / r)
+        } else {
+            (1.0, 0.0)
+        };
+        let out = if nearest.hole { -1.0 } else { 1.0 };
+        Vector3::new(out * ux * phi.sin(), out * uy * phi.sin(), up * phi.cos())
+    }
+}
+
 impl HoledMesh {
     /// The genus-n mesh at `resolution` (boundary points around a hole, or around half the sphere's equator;
     /// 8 to 1024). Triangles have angles ≥ 20° in the plan; the rounded rims stretch them by up to π/2
@@ -619,6 +654,7 @@ fn lift(
     let mut top = vec![u32::MAX; cdt.num_vertices()];
     let mut bottom = vec![u32::MAX; cdt.num_vertices()];
     let mut positions = Vec::new();
+    let mut normals = Vec::new();
     for f in &faces {
         for &v in f {
             if top[v] != u32::MAX {
@@ -627,11 +663,13 @@ fn lift(
             let q = plan_points[v];
             top[v] = positions.len() as u32;
             positions.push(plan.lift(q, Side::Top));
+            normals.push(plan.normal(q, Side::Top));
             if on_boundary.contains(&v) {
                 bottom[v] = top[v];
             } else {
                 bottom[v] = positions.len() as u32;
                 positions.push(plan.lift(q, Side::Bottom));
+                normals.push(plan.normal(q, Side::Bottom));
             }
         }
     }
@@ -665,6 +703,7 @@ fn lift(
         loops,
         base: if base == u32::MAX { 0 } else { base },
         thickness: plan.thickness,
+        normals,
     })
 }
 
@@ -737,7 +776,70 @@ mod tests {
         assert!((curvature(Profile::Round, 1e-3) - 1.0).abs() < 1e-3);
     }
 
+    #[test]
+    fn intended_normals_are_the_spheres_radii_and_match_the_mesh() {
+        let sphere = HoledMesh::new(0, 16).unwrap();
+        for (p, n) in sphere.positions.iter().zip(&sphere.normals) {
+            assert!((p.coords - n).norm() < 1e-12, "{p} {n}");
+        }
+        for genus in 0..=4 {
+            // The mesh's area-weighted vertex normals approach the intended ones as it refines.
+            let spread = |resolution| {
+                let mesh = HoledMesh::new(genus, resolution).unwrap();
+                assert_eq!(mesh.normals.len(), mesh.positions.len());
+                let mut sums = vec![Vector3::zeros(); mesh.positions.len()];
+                for t in &mesh.triangles {
+                    let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+                    let n = (b - a).cross(&(c - a));
+                    for &v in t {
+                        sums[v as usize] += n;
+                    }
+                }
+                let mut angles: Vec<f64> = sums
+                    .iter()
+                    .zip(&mesh.normals)
+                    .map(|(m, n)| {
+                        assert!((n.norm() - 1.0).abs() < 1e-12);
+                        m.angle(n).to_degrees()
+                    })
+                    .collect();
+                angles.sort_by(f64::total_cmp);
+                (angles[angles.len() / 2], angles[angles.len() * 99 / 100])
+            };
+            let (coarse, fine) = (spread(16), spread(48));
+            assert!(
+                fine.0 < 1.0 && fine.1 < coarse.1,
+                "genus {genus}: {coarse:?} → {fine:?}"
+            );
+        }
+    }
+
     proptest! {
+        /// The normal is perpendicular to the lift's derivatives in the plan.
+        #[test]
+        fn intended_normals_are_normal_to_the_lift(
+            genus in 2u32..9, x in -4.0f64..4.0, y in -4.0f64..4.0, top in any::<bool>(),
+        ) {
+            let plan = Plan::plate(genus, 0.1);
+            let q = [x, y];
+            let depth = plan.circles.iter().map(|c| c.depth(q)).fold(f64::INFINITY, f64::min);
+            // Inside the region, away from the circles (where the lift's derivative is infinite)
+            // and from the band's inner edge (where the difference straddles its kink in speed).
+            prop_assume!(depth > 1e-3 && (depth - plan.band).abs() > 1e-4);
+            let side = if top { Side::Top } else { Side::Bottom };
+            let n = plan.normal(q, side);
+            let h = 1e-6;
+            for e in [[h, 0.0], [0.0, h]] {
+                let a = plan.lift([x - e[0], y - e[1]], side);
+                let b = plan.lift([x + e[0], y + e[1]], side);
+                let tangent = (b - a).normalize();
+                prop_assert!(tangent.dot(&n).abs() < 1e-5, "{tangent} · {n}");
+            }
+            // Outward: up on the top, down on the bottom.
+            let outward = if top { n.z > 0.0 } else { n.z < 0.0 };
+            prop_assert!(outward || n.z.abs() < 1e-9);
+        }
+
         /// The curve's tangent turns by φ(t): the quadrature and the scaling agree with the angle.
         #[test]
         fn the_tangent_follows_the_angle(t in 0.001f64..0.999, eased in any::<bool>()) {

@@ -180,14 +180,25 @@ pub fn normal_deviation(
             mesh_normals[v as usize] += n;
         }
     }
-    let mut angles = vec![180.0; points.len().min(positions.len())];
+    normal_deviation_from(surface, points, &mesh_normals)
+}
+
+/// The angle between the surface's normal at `points[i]` and `normals[i]` (any length; e.g. the
+/// intended shape's exact normals, which [`crate::holed::HoledMesh`] knows), over every point. A
+/// point whose normal is undefined, on either side, counts as 180°.
+pub fn normal_deviation_from(
+    surface: &Surface,
+    points: &[ChartPoint],
+    normals: &[Vector3],
+) -> AngleSpread {
+    let mut angles = vec![180.0; points.len().min(normals.len())];
     evaluate::evaluate(
         surface,
         &points[..angles.len()],
         evaluate::Wants::default(),
         0.0,
         &mut |s: &evaluate::Sample| {
-            let (m, n) = (mesh_normals[s.index], s.normal);
+            let (m, n) = (normals[s.index], s.normal);
             if let Some(n) = n
                 && m.norm() > 0.0
             {

@@ -139,6 +139,7 @@ fn as_fitted<'a>(
         parameterization: &fit.parameterization,
         positions: &valid.positions,
         triangles: &valid.triangles,
+        intended_normals: None,
         rms_residual: fit.rms_residual,
         max_residual: fit.max_residual,
         mesh_diagonal: fit.mesh_diagonal,

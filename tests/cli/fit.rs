@@ -23,6 +23,8 @@ fn fit_writes_a_model_of_the_mesh_genus_that_passes_its_checks() {
     assert_eq!(report["fit"]["passed"], true);
     assert_eq!(report["fit"]["genus"], 3);
     assert_eq!(report["fit"]["folded_triangles"], 0);
+    // A user's mesh has no intended shape beyond itself: its own normals are the reference.
+    assert_eq!(report["fit"]["shape"]["normals_from"], "mesh");
     assert_eq!(report["loops"]["loop_edges"].as_array().unwrap().len(), 6);
     assert!(report["fit"]["max_residual"].as_f64().unwrap() < 0.01);
     let model: embedding::Model =

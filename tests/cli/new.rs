@@ -130,6 +130,25 @@ fn the_report_measures_the_shape() {
     );
     assert!(number("normal_deviation_median") <= number("normal_deviation_p90"));
     assert!(number("normal_deviation_p90") < 10.0, "{shape}");
+    // Measured against the sphere's exact normals, and the same as the library measures there.
+    assert_eq!(shape["normals_from"], "intended", "{shape}");
+    let surface = ntori::io::model_file::load(&path).unwrap();
+    let made = embedding::fit::initial_model(
+        0,
+        16,
+        surface.settings(),
+        embedding::fit::FitSettings::default(),
+    )
+    .unwrap();
+    let direct = embedding::quality::normal_deviation_from(
+        &surface,
+        &made.parameterization.points,
+        &made.mesh.normals,
+    );
+    assert!(
+        (number("normal_deviation_p90") - direct.p90).abs() < 1e-6,
+        "{shape}"
+    );
     // The disagreement is the library's, measured on the model as written (16×16 tessellation).
     assert!(number("patch_disagreement_rms") <= number("patch_disagreement"));
     let surface = ntori::io::model_file::load(&path).unwrap();
