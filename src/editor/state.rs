@@ -48,7 +48,10 @@ pub const MAX_T: u32 = 256;
 pub const MIN_RADIUS: f64 = 0.01;
 pub const MAX_RADIUS: f64 = 0.5;
 
-/// A stroke brush's radius, as a fraction of the model's size, when no influence radius is set.
+/// The brush radius the editor starts with, as a fraction of the model's size, and a stroke
+/// brush's radius when the radius has been turned off. Drags start as a brush with a smooth
+/// falloff rather than the paper's edit (radius off), whose footprint is the control spacing: at
+/// grid 16 a pointed peak, at grid 32 a narrow spike the view's tessellation shows as jagged.
 pub const DEFAULT_STROKE_RADIUS: f64 = 0.15;
 
 /// The t_e and t_r the panel offers first when switching to the t_e/t_r tessellation.
@@ -113,7 +116,7 @@ impl EditorState {
             history: History::new(),
             path: None,
             saved_state: 0,
-            influence: 0.0,
+            influence: DEFAULT_STROKE_RADIUS,
             falloff: Falloff::Smooth,
             brush: BrushKind::Grab,
             strength: 0.5,
