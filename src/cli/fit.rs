@@ -72,7 +72,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let valid = import::validate(read, args.largest)
         .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
     refuse_unfittable(&args.mesh, &valid)?;
-    let (settings, fit) = args.spline.settings();
+    let (settings, fit) = args.spline.settings(FIT_GRID);
     let bar = spinner(args.quiet);
     let progress = |stage: &str| {
         bar.set_message(stage.to_string());
@@ -114,6 +114,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     emit(&report, args.json)
 }
+
+/// `ntori fit`'s grid where none is given. Users' meshes are often far coarser than `new`'s
+/// plates, and a grid finer than the data overfits: at 32 the 1581-vertex
+/// `assets/meshes/plate-genus-3.obj` fitted with |κ| up to 178 and patches 1.9% of the diagonal
+/// apart (0.9% at 16), the dumbbell's normals turned 5.2° from its mesh's at the 90th percentile
+/// (2.3° at 16).
+const FIT_GRID: usize = 16;
 
 /// Meshes beyond the fit's size are refused before any work.
 fn refuse_unfittable(path: &Path, valid: &ValidMesh) -> anyhow::Result<()> {

@@ -95,10 +95,10 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 /// The spline and the fit's weight, as `new` and `fit` take them.
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct FitArgs {
-    /// Control points per side of each chart's grid.
-    #[arg(long, default_value_t = SplineSettings::default().grid as u64, value_name = "G",
-          value_parser = clap::value_parser!(u64).range(4..=64))]
-    grid: u64,
+    /// Control points per side of each chart's grid [default: 32 for new, 16 for fit: a user's
+    /// mesh is often coarser than the plates, and a grid finer than the data overfits it]
+    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=64))]
+    grid: Option<u64>,
     /// Spline degree.
     #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
           value_parser = clap::value_parser!(u64).range(1..=7))]
@@ -114,11 +114,12 @@ struct FitArgs {
 }
 
 impl FitArgs {
-    fn settings(&self) -> (SplineSettings, FitSettings) {
+    /// The settings asked for; the grid is `default_grid` where none was given.
+    fn settings(&self, default_grid: usize) -> (SplineSettings, FitSettings) {
         let spline = SplineSettings {
             degree: self.degree as usize,
             continuity: self.continuity as usize,
-            grid: self.grid as usize,
+            grid: self.grid.map_or(default_grid, |g| g as usize),
         };
         let fit = FitSettings {
             smoothness: self.smoothness,
