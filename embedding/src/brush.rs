@@ -17,9 +17,10 @@
 //! the field as well, weighted by its blend (else patches disagree in the overlaps and ripple), and
 //! the second differences of the shares over each chart's grid are kept small (fairness, so a steep
 //! profile such as a dome's rim does not ring). What a spline of the model's grid can show sets a
-//! floor on the radius: on the default genus-2 model (grid 16) footprints match the falloff from
-//! about 0.2 of the model's size in every chart, and from 0.12 in the edge charts; below that the
-//! bump comes out wider and lower, and the correction still takes the dragged point to its target.
+//! floor on the radius: on a genus-2 plate at grid 16 (the default grid until it became 32)
+//! footprints match the falloff from about 0.2 of the model's size in every chart, and from 0.12 in
+//! the edge charts; below that the bump comes out wider and lower, and the correction still takes
+//! the dragged point to its target.
 //!
 //! Because the fit sees only model-space distances and surface samples, the same brush at the
 //! same surface point gives the same shares whichever chart the point was picked in, and footprints
