@@ -391,64 +391,19 @@ impl Plan {
         TAU * radius / resolution as f64
     }
 
-    /// The lift of a plan point to the top (or, mirrored, bottom) face: flat where it lies deeper than
-    /// the band, folded over the profile's quarter turn (W wide in the plan, T high) near a rim.
-    fn lift(&self, q: P2, side: Side) -> Point3 {
+    /// Where `q` lies in a rim's band: t (0 at the band's inner edge, where the face is flat, 1 on
+    /// the circle, where it is vertical) and the unit vector in the plan pointing out of the
+    /// region across the nearest circle. `None` on the flat faces, deeper than the band.
+    fn in_band(&self, q: P2) -> Option<(f64, [f64; 2])> {
         let nearest = self
             .circles
             .iter()
             .min_by(|a, b| a.depth(q).total_cmp(&b.depth(q)))
             .expect("a plan has at least one circle");
         let d = nearest.depth(q).max(0.0);
-        let (x, y, z) = if d >= self.band {
-            (q[0], q[1], self.thickness)
-        } else {
-            // t = 0 at the inner edge of the band (flat), 1 on the circle (vertical).
-            let t = 1.0 - d / self.band;
-            let (across, drop) = self.profile.at(t);
-            let (dx, dy) = (q[0] - nearest.centre[0], q[1] - nearest.centre[1]);
-            let r = dx.hypot(dy);
-            // Unit vector pointing out of the region, across the circle.
-            let (ux, uy) = if r > 0.0 {
-                (dx / r, dy / r)
-            } else {
-                (1.0, 0.0)
-            };
-            let out = if nearest.hole { -1.0 } else { 1.0 };
-            // The plan point lies W·t beyond the band's inner edge; the lift lies W·across beyond it.
-            let reach = self.band * (across - t);
-            (
-                q[0] + out * ux * reach,
-                q[1] + out * uy * reach,
-                self.thickness * (1.0 - drop),
-            )
-        };
-        match side {
-            Side::Top => Point3::new(x, y, z),
-            Side::Bottom => Point3::new(x, y, -z),
-        }
-    }
-}
-
-impl Plan {
-    /// The unit outward normal of the lifted surface at the lift of `q`: +z (or −z) on the flat
-    /// faces; in a band, the profile's normal (sin φ across the circle, cos φ up), since the lift
-    /// moves a point straight across its nearest circle.
-    fn normal(&self, q: P2, side: Side) -> Vector3 {
-        let nearest = self
-            .circles
-            .iter()
-            .min_by(|a, b| a.depth(q).total_cmp(&b.depth(q)))
-            .expect("a plan has at least one circle");
-        let d = nearest.depth(q).max(0.0);
-        let up = match side {
-            Side::Top => 1.0,
-            Side::Bottom => -1.0,
-        };
         if d >= self.band {
-            return Vector3::new(0.0, 0.0, up);
+            return None;
         }
-        let phi = self.profile.angle(1.0 - d / self.band);
         let (dx, dy) = (q[0] - nearest.centre[0], q[1] - nearest.centre[1]);
         let r = dx.hypot(dy);
         let (ux, uy) = if r > 0.0 {
@@ -457,7 +412,47 @@ impl Plan {
             (1.0, 0.0)
         };
         let out = if nearest.hole { -1.0 } else { 1.0 };
-        Vector3::new(out * ux * phi.sin(), out * uy * phi.sin(), up * phi.cos())
+        Some((1.0 - d / self.band, [out * ux, out * uy]))
+    }
+
+    /// The lift of a plan point to the top (or, mirrored, bottom) face: flat where it lies deeper than
+    /// the band, folded over the profile's quarter turn (W wide in the plan, T high) near a rim.
+    fn lift(&self, q: P2, side: Side) -> Point3 {
+        let (x, y, z) = match self.in_band(q) {
+            None => (q[0], q[1], self.thickness),
+            Some((t, out)) => {
+                let (across, drop) = self.profile.at(t);
+                // The plan point lies W·t beyond the band's inner edge; the lift lies W·across
+                // beyond it.
+                let reach = self.band * (across - t);
+                (
+                    q[0] + out[0] * reach,
+                    q[1] + out[1] * reach,
+                    self.thickness * (1.0 - drop),
+                )
+            }
+        };
+        match side {
+            Side::Top => Point3::new(x, y, z),
+            Side::Bottom => Point3::new(x, y, -z),
+        }
+    }
+
+    /// The unit outward normal of the lifted surface at the lift of `q`: +z (or −z) on the flat
+    /// faces; in a band, the profile's normal (sin φ across the circle, cos φ up), since the lift
+    /// moves a point straight across its nearest circle.
+    fn normal(&self, q: P2, side: Side) -> Vector3 {
+        let up = match side {
+            Side::Top => 1.0,
+            Side::Bottom => -1.0,
+        };
+        match self.in_band(q) {
+            None => Vector3::new(0.0, 0.0, up),
+            Some((t, out)) => {
+                let phi = self.profile.angle(t);
+                Vector3::new(out[0] * phi.sin(), out[1] * phi.sin(), up * phi.cos())
+            }
+        }
     }
 }
 
