@@ -76,6 +76,8 @@ pub enum EmbeddingError {
     BadPin { index: usize, problem: String },
     #[error("constraint {0} asks for a position that is not a finite point")]
     BadTarget(usize),
+    #[error("the surface's tessellation cannot be checked: {0}")]
+    Tessellation(#[from] mesh::spatial::SpatialError),
     #[error("the edit's constraints could not be solved")]
     Unsolvable,
     #[error("the {0} brush has no dab: it follows the pointer")]

@@ -7,8 +7,10 @@ use std::sync::Arc;
 
 use charts::{Atlas, ChartId};
 use embedding::fit::{FitSettings, initial_model};
+use embedding::holed::HoledMesh;
 use embedding::quality::{
-    max_principal_curvature, normal_deviation, patch_disagreement, sample_points,
+    max_principal_curvature, mesh_max_principal_curvature, normal_deviation, patch_disagreement,
+    sample_points, tessellation_crossings, vertex_normals,
 };
 use embedding::{Layout, Model, Point3, SplineSettings, Stencil, Surface, Vector3};
 use proptest::prelude::*;
@@ -86,6 +88,113 @@ proptest! {
             prop_assert!((k1 * k2 - k).abs() <= 1e-7 * scale * scale, "{k1} {k2} {k}");
         }
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// The unit sphere and the torus of radii 2 and 1 both have largest |κ| = 1: moved, turned and
+    /// scaled by s, the mesh estimate reads 1/s, from the exact normals and from the mesh's own.
+    #[test]
+    fn a_meshs_largest_curvature_is_one_over_the_radius_of_its_sphere_or_tube(
+        genus in 0u32..=1,
+        scale in 0.01f64..100.0,
+        axis in prop::array::uniform3(-1.0f64..1.0),
+        angle in 0.0f64..6.3,
+        offset in prop::array::uniform3(-1e3f64..1e3),
+    ) {
+        let mesh = HoledMesh::new(genus, 32).unwrap();
+        let axis = Vector3::from(axis);
+        prop_assume!(axis.norm() > 1e-3);
+        let turn = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), angle);
+        let positions: Vec<Point3> = mesh
+            .positions
+            .iter()
+            .map(|p| turn * (p * scale) + Vector3::from(offset))
+            .collect();
+        let exact: Vec<Vector3> = mesh.normals.iter().map(|n| turn * n).collect();
+        let from_exact = mesh_max_principal_curvature(&positions, &mesh.triangles, &exact) * scale;
+        let own = vertex_normals(&positions, &mesh.triangles);
+        let from_mesh = mesh_max_principal_curvature(&positions, &mesh.triangles, &own) * scale;
+        prop_assert!((from_exact - 1.0).abs() < 0.05, "genus {genus}: {from_exact}");
+        prop_assert!((from_mesh - 1.0).abs() < 0.15, "genus {genus}: {from_mesh}");
+    }
+}
+
+#[test]
+fn a_plates_curvature_estimate_settles_as_its_mesh_refines() {
+    // The eased rims' curvature peaks at about 1.4 / T across the band (T the half-thickness), about
+    // 4 for the default plates. The estimate from the exact normals barely moves from resolution 24
+    // to 48.
+    for genus in [2, 5] {
+        let at = |resolution| {
+            let mesh = HoledMesh::new(genus, resolution).unwrap();
+            mesh_max_principal_curvature(&mesh.positions, &mesh.triangles, &mesh.normals)
+        };
+        let (coarse, fine) = (at(24), at(48));
+        assert!((3.0..5.0).contains(&fine), "genus {genus}: {fine}");
+        assert!(
+            (coarse - fine).abs() < 0.03 * fine,
+            "genus {genus}: {coarse} vs {fine}"
+        );
+    }
+}
+
+#[test]
+fn a_flat_mesh_has_no_curvature_and_a_rough_one_reads_more_curved() {
+    // A flat 10 × 10 grid with one normal: no curvature at all.
+    let n = 10u32;
+    let positions: Vec<Point3> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| Point3::new(f64::from(i), f64::from(j), 3.0)))
+        .collect();
+    let triangles: Vec<[u32; 3]> = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| {
+                let v = j * (n + 1) + i;
+                [[v, v + 1, v + n + 2], [v, v + n + 2, v + n + 1]]
+            })
+        })
+        .collect();
+    let up = vec![Vector3::z(); positions.len()];
+    assert_eq!(
+        mesh_max_principal_curvature(&positions, &triangles, &up),
+        0.0
+    );
+    // The unit sphere, each vertex moved along its radius by up to 1%: its own normals scatter and
+    // the estimate rises well above 1.
+    let mesh = HoledMesh::new(0, 32).unwrap();
+    let rough: Vec<Point3> = mesh
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p * (1.0 + 0.01 * (i as f64 * 12.9898).sin()))
+        .collect();
+    let own = vertex_normals(&rough, &mesh.triangles);
+    let k = mesh_max_principal_curvature(&rough, &mesh.triangles, &own);
+    assert!(k > 2.0, "{k}");
+}
+
+#[test]
+fn a_fitted_surface_does_not_cross_itself_and_one_turned_inside_out_does() {
+    let settings = SplineSettings {
+        grid: 8,
+        ..SplineSettings::default()
+    };
+    let fit = initial_model(0, 16, settings, FitSettings::default()).unwrap();
+    assert_eq!(tessellation_crossings(&fit.surface, 12).unwrap(), 0);
+    // One cap's control points mirrored through the equator's plane: that patch now pokes through
+    // the other half of the sphere where the two blend.
+    let layout = fit.surface.layout();
+    let grid = settings.grid;
+    let mut control = fit.surface.control_points().to_vec();
+    for j in 0..grid {
+        for i in 0..grid {
+            let c = &mut control[layout.control_index(ChartId(0), i, j)];
+            c.z = -c.z;
+        }
+    }
+    let turned = fit.surface.with_control_points(control).unwrap();
+    assert!(tessellation_crossings(&turned, 12).unwrap() > 0);
 }
 
 #[test]
