@@ -2,9 +2,10 @@
 //! (Catmull–Clark uniform refinement stencils and limit stencils) and its CPU evaluator, through a
 //! small C++ shim over the system library (Debian's `libosd-dev`, OpenSubdiv 3.5).
 //!
-//! Benches and comparison tests use it; nothing in ntori's own pipeline does. Without the library
-//! the crate still builds and [`available`] is false: every constructor then returns
-//! [`Error::Unavailable`], so a machine without OpenSubdiv can build and test everything else.
+//! Benches and comparison tests use it, and `ntori fit --cage` reads a Catmull–Clark cage's limit
+//! surface through [`Refiner::limit_mesh`]. Without the library the crate still builds and
+//! [`available`] is false: every constructor then returns [`Error::Unavailable`], so a machine
+//! without OpenSubdiv can build and test everything else.
 //!
 //! Bench inputs: [`QuadMesh::genus_cage`] makes a closed all-quad cage of any genus.
 
@@ -45,25 +46,95 @@ pub struct Refiner {
 impl Refiner {
     /// A refiner for `mesh`'s topology (its positions are not needed until stencils are applied).
     pub fn new(mesh: &QuadMesh) -> Result<Refiner, Error> {
+        let sides = vec![4; mesh.faces.len()];
+        Refiner::from_polygons(mesh.positions.len(), &sides, mesh.faces.as_flattened())
+    }
+
+    /// A refiner for a closed polygon mesh of `vertices` vertices: polygon f has `sides[f]` corners,
+    /// the next ones of `corners` (counter-clockwise seen from outside).
+    pub fn from_polygons(
+        vertices: usize,
+        sides: &[u32],
+        corners: &[u32],
+    ) -> Result<Refiner, Error> {
         if !available() {
             return Err(Error::Unavailable);
         }
-        let counts = vec![4i32; mesh.faces.len()];
-        let indices = mesh
-            .faces
+        let total: u64 = sides.iter().map(|&s| u64::from(s)).sum();
+        if total != corners.len() as u64 || corners.iter().any(|&c| c as usize >= vertices) {
+            return Err(Error::Failed(
+                "read the polygons (corner counts or indices out of range)",
+            ));
+        }
+        let counts = sides
             .iter()
-            .flatten()
+            .map(|&s| int(s as usize))
+            .collect::<Result<Vec<i32>, Error>>()?;
+        let indices = corners
+            .iter()
             .map(|&v| int(v as usize))
             .collect::<Result<Vec<i32>, Error>>()?;
-        let (v, f) = (int(mesh.positions.len())?, int(mesh.faces.len())?);
-        // SAFETY: counts holds f entries summing to indices.len(); the shim copies what it keeps.
+        let (v, f) = (int(vertices)?, int(sides.len())?);
+        // SAFETY: counts holds f entries summing to indices.len() (checked above), every index is
+        // below v; the shim copies what it keeps.
         let raw = unsafe { sys::ntori_osd_refiner_new(v, f, counts.as_ptr(), indices.as_ptr()) };
         if raw.is_null() {
             return Err(Error::Failed("build the topology refiner"));
         }
         Ok(Refiner {
             raw,
-            base_vertices: mesh.positions.len(),
+            base_vertices: vertices,
+        })
+    }
+
+    /// Refines uniformly to `level` (1 to 8) and returns the finest level's mesh with every vertex
+    /// moved to its place on the limit surface of the cage whose vertices are at `base` (one per
+    /// base vertex). After one level every face of a Catmull–Clark mesh is a quad.
+    pub fn limit_mesh(&self, level: u32, base: &[[f64; 3]]) -> Result<LimitMesh, Error> {
+        if base.len() != self.base_vertices {
+            return Err(Error::Failed("match the positions to the cage's vertices"));
+        }
+        let level = level.clamp(1, 8);
+        // SAFETY: raw is a live refiner.
+        let vertices = unsafe { sys::ntori_osd_refine_uniform_full(self.raw, level as i32) };
+        if vertices <= 0 {
+            return Err(Error::Failed("refine uniformly"));
+        }
+        let (mut faces, mut corners) = (0i32, 0i32);
+        // SAFETY: raw is refined; the two outputs are plain ints.
+        unsafe { sys::ntori_osd_finest_sizes(self.raw, &mut faces, &mut corners) };
+        if corners != 4 * faces {
+            return Err(Error::Failed("refine to quads"));
+        }
+        let mut counts = vec![0i32; faces as usize];
+        let mut indices = vec![0i32; corners as usize];
+        // SAFETY: counts and indices have the sizes the shim just reported.
+        unsafe { sys::ntori_osd_finest_faces(self.raw, counts.as_mut_ptr(), indices.as_mut_ptr()) };
+        let mut positions = vec![[0.0f64; 3]; vertices as usize];
+        let (mut du, mut dv) = (positions.clone(), positions.clone());
+        // SAFETY: base holds base_vertices points; positions, du and dv one per finest vertex; each
+        // point is three doubles, as the shim reads and writes them.
+        let ok = unsafe {
+            sys::ntori_osd_limit_positions(
+                self.raw,
+                base.as_flattened().as_ptr(),
+                positions.as_flattened_mut().as_mut_ptr(),
+                du.as_flattened_mut().as_mut_ptr(),
+                dv.as_flattened_mut().as_mut_ptr(),
+            )
+        };
+        if ok != 1 {
+            return Err(Error::Failed("evaluate the limit positions"));
+        }
+        let faces = indices
+            .chunks_exact(4)
+            .map(|q| [q[0], q[1], q[2], q[3]].map(|v| v as u32))
+            .collect();
+        let normals = du.iter().zip(&dv).map(|(a, b)| cross(*a, *b)).collect();
+        Ok(LimitMesh {
+            positions,
+            normals,
+            faces,
         })
     }
 
@@ -133,6 +204,25 @@ impl Drop for Refiner {
         // SAFETY: raw came from ntori_osd_refiner_new and is freed once.
         unsafe { sys::ntori_osd_refiner_free(self.raw) }
     }
+}
+
+/// A uniformly refined Catmull–Clark mesh with its vertices on the limit surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitMesh {
+    pub positions: Vec<[f64; 3]>,
+    /// The limit surface's normal at each vertex: the cross product of its two limit tangents (not
+    /// unit length), on the side the faces' counter-clockwise order makes outward.
+    pub normals: Vec<[f64; 3]>,
+    /// Quads, oriented as the cage's faces.
+    pub faces: Vec<[u32; 4]>,
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// A table of stencils (rows of weights on the base mesh's vertices), uniform or limit.
@@ -393,6 +483,86 @@ mod tests {
                 .all(|q| q.iter().all(|c| (-0.01..=5.01).contains(c)))
         );
         assert!(p.iter().any(|q| (q[0] - p[0][0]).abs() > 0.5));
+    }
+
+    /// The limit mesh's vertices lie where the limit stencils (an independent path through
+    /// OpenSubdiv) put them: a base vertex's descendant at the corner (0, 0) of a face that starts
+    /// there, and every vertex at the limit whatever the level.
+    #[test]
+    fn limit_mesh_vertices_are_on_the_limit_surface() {
+        if !linked() {
+            return;
+        }
+        for genus in [0, 2] {
+            let cage = QuadMesh::genus_cage(genus);
+            let base: Vec<[f64; 3]> = cage.positions.iter().map(|p| p.map(f64::from)).collect();
+            let coarse = Refiner::new(&cage).unwrap().limit_mesh(2, &base).unwrap();
+            let fine = Refiner::new(&cage).unwrap().limit_mesh(4, &base).unwrap();
+            assert_eq!(fine.positions.len(), cage.refined_vertex_count(4));
+            assert_eq!(fine.faces.len(), cage.faces.len() * 256);
+            // Vertices are numbered vertex children first, so the first ones descend from the base
+            // vertices at every level; their limit points do not depend on the level.
+            for v in 0..base.len() {
+                for k in 0..3 {
+                    let (a, b) = (coarse.positions[v][k], fine.positions[v][k]);
+                    assert!(
+                        (a - b).abs() < 1e-12,
+                        "genus {genus}, vertex {v}: {a} vs {b}"
+                    );
+                }
+            }
+            let refiner = Refiner::new(&cage).unwrap();
+            refiner.refine_adaptive(4).unwrap();
+            let corners: Vec<(u32, f32, f32)> = (0..cage.faces.len() as u32)
+                .map(|f| (f, 0.0, 0.0))
+                .collect();
+            let table = refiner.limit_stencils(&corners, false).unwrap();
+            let mut at = vec![[0.0f32; 3]; corners.len()];
+            table.apply(&cage.positions, &mut at).unwrap();
+            for (f, face) in cage.faces.iter().enumerate() {
+                let mine = fine.positions[face[0] as usize];
+                for k in 0..3 {
+                    assert!(
+                        (mine[k] - f64::from(at[f][k])).abs() < 1e-5,
+                        "genus {genus}, face {f}: {mine:?} vs {:?}",
+                        at[f]
+                    );
+                }
+            }
+            // The limit normals point the way the quads face (the faces are tiny against the
+            // curvature at level 4).
+            for q in &fine.faces {
+                let p = q.map(|v| fine.positions[v as usize]);
+                let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                let facing = cross(sub(p[1], p[0]), sub(p[3], p[0]));
+                for &v in q {
+                    let n = fine.normals[v as usize];
+                    let dot: f64 = (0..3).map(|k| n[k] * facing[k]).sum();
+                    assert!(dot > 0.0, "genus {genus}: vertex {v} faces away");
+                }
+            }
+            // Closed: every edge of the quads is shared by two of them, in opposite directions.
+            let mut edges = std::collections::HashMap::new();
+            for q in &fine.faces {
+                for i in 0..4 {
+                    *edges.entry((q[i], q[(i + 1) % 4])).or_insert(0) += 1;
+                }
+            }
+            assert!(
+                edges
+                    .iter()
+                    .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
+            );
+        }
+    }
+
+    #[test]
+    fn polygons_that_do_not_add_up_are_refused() {
+        if !linked() {
+            return;
+        }
+        assert!(Refiner::from_polygons(4, &[4, 3], &[0, 1, 2, 3, 0, 1]).is_err());
+        assert!(Refiner::from_polygons(3, &[3], &[0, 1, 7]).is_err());
     }
 
     #[test]

@@ -1,9 +1,11 @@
-// A C interface to the parts of OpenSubdiv 3.5 that ntori is measured against: a Catmull-Clark
-// topology refiner, its uniform refinement stencils, its limit stencils at given (face, s, t)
-// locations, and the CPU evaluator that applies them. Each phase is its own call so that the Rust
+// A C interface to the parts of OpenSubdiv 3.5 that ntori is measured against and reads cages with:
+// a Catmull-Clark topology refiner, its uniform refinement stencils, its limit stencils at given
+// (face, s, t) locations, the CPU evaluator that applies them, and a uniformly refined mesh with its
+// vertices on the limit surface (`ntori fit --cage`). Each phase is its own call so that the Rust
 // side can time the factories apart from refinement. Every entry point catches C++ exceptions and
 // reports failure as a null pointer or a zero return; none of them throws into Rust.
 
+#include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/stencilTable.h>
 #include <opensubdiv/far/stencilTableFactory.h>
 #include <opensubdiv/far/topologyDescriptor.h>
@@ -189,6 +191,84 @@ int ntori_osd_apply_with_derivatives(const void *table, const float *src, float 
                                            end)
                ? 1
                : 0;
+}
+
+namespace {
+// A double-precision position for Far's PrimvarRefiner (interpolation and limit) templates.
+struct Point64 {
+    double p[3];
+    void Clear(void * = nullptr) { p[0] = p[1] = p[2] = 0.0; }
+    void AddWithWeight(Point64 const &src, double w) {
+        p[0] += w * src.p[0];
+        p[1] += w * src.p[1];
+        p[2] += w * src.p[2];
+    }
+};
+}  // namespace
+
+// Uniform refinement to `level` keeping the finest level's whole topology (its faces, and the
+// neighbourhoods the limit masks need); returns that level's vertex count, 0 on failure.
+int ntori_osd_refine_uniform_full(void *refiner, int level) {
+    try {
+        Far::TopologyRefiner *r = static_cast<Far::TopologyRefiner *>(refiner);
+        Far::TopologyRefiner::UniformOptions options(level);
+        options.fullTopologyInLastLevel = true;
+        r->RefineUniform(options);
+        return r->GetLevel(level).GetNumVertices();
+    } catch (...) {
+        return 0;
+    }
+}
+
+// The finest level's face count and the total of their corners, into `faces` and `corners`.
+void ntori_osd_finest_sizes(const void *refiner, int *faces, int *corners) {
+    Far::TopologyRefiner const *r = static_cast<Far::TopologyRefiner const *>(refiner);
+    Far::TopologyLevel const &level = r->GetLevel(r->GetMaxLevel());
+    *faces = level.GetNumFaces();
+    *corners = level.GetNumFaceVertices();
+}
+
+// The finest level's faces: `counts[f]` corners for face f, their vertex indices in `indices`.
+void ntori_osd_finest_faces(const void *refiner, int *counts, int *indices) {
+    Far::TopologyRefiner const *r = static_cast<Far::TopologyRefiner const *>(refiner);
+    Far::TopologyLevel const &level = r->GetLevel(r->GetMaxLevel());
+    int k = 0;
+    for (int f = 0; f < level.GetNumFaces(); ++f) {
+        Far::ConstIndexArray corners = level.GetFaceVertices(f);
+        counts[f] = corners.size();
+        for (int c = 0; c < corners.size(); ++c) indices[k++] = corners[c];
+    }
+}
+
+// The limit positions of the finest level's vertices (after ntori_osd_refine_uniform_full), from
+// the base mesh's positions (x, y, z each): interpolated level by level, then taken to the limit,
+// with two limit tangents per vertex into `du` and `dv`. 1 on success.
+int ntori_osd_limit_positions(const void *refiner, const double *base, double *out, double *du,
+                              double *dv) {
+    try {
+        Far::TopologyRefiner const *r = static_cast<Far::TopologyRefiner const *>(refiner);
+        // Weights in double too, so the limit points carry no float rounding.
+        Far::PrimvarRefinerReal<double> primvar(*r);
+        int levels = r->GetMaxLevel();
+        std::vector<Point64> src(r->GetLevel(0).GetNumVertices());
+        for (size_t v = 0; v < src.size(); ++v)
+            for (int i = 0; i < 3; ++i) src[v].p[i] = base[3 * v + i];
+        for (int level = 1; level <= levels; ++level) {
+            std::vector<Point64> dst(r->GetLevel(level).GetNumVertices());
+            Point64 const *from = src.data();
+            Point64 *to = dst.data();
+            primvar.Interpolate(level, from, to);
+            src.swap(dst);
+        }
+        Point64 *limit = reinterpret_cast<Point64 *>(out);
+        Point64 *tan1 = reinterpret_cast<Point64 *>(du);
+        Point64 *tan2 = reinterpret_cast<Point64 *>(dv);
+        Point64 const *finest = src.data();
+        primvar.Limit(finest, limit, tan1, tan2);
+        return 1;
+    } catch (...) {
+        return 0;
+    }
 }
 
 }  // extern "C"

@@ -20,6 +20,16 @@ mod linked {
         pub fn ntori_osd_refiner_free(refiner: *mut c_void);
         pub fn ntori_osd_refine_uniform(refiner: *mut c_void, level: i32) -> i32;
         pub fn ntori_osd_refine_adaptive(refiner: *mut c_void, level: i32) -> i32;
+        pub fn ntori_osd_refine_uniform_full(refiner: *mut c_void, level: i32) -> i32;
+        pub fn ntori_osd_finest_sizes(refiner: *const c_void, faces: *mut i32, corners: *mut i32);
+        pub fn ntori_osd_finest_faces(refiner: *const c_void, counts: *mut i32, indices: *mut i32);
+        pub fn ntori_osd_limit_positions(
+            refiner: *const c_void,
+            base: *const f64,
+            out: *mut f64,
+            du: *mut f64,
+            dv: *mut f64,
+        ) -> i32;
         pub fn ntori_osd_uniform_stencils(refiner: *const c_void) -> *mut c_void;
         pub fn ntori_osd_limit_stencils(
             refiner: *const c_void,
@@ -78,6 +88,20 @@ mod missing {
         0
     }
     pub unsafe extern "C" fn ntori_osd_refine_adaptive(_: *mut c_void, _: i32) -> i32 {
+        0
+    }
+    pub unsafe extern "C" fn ntori_osd_refine_uniform_full(_: *mut c_void, _: i32) -> i32 {
+        0
+    }
+    pub unsafe extern "C" fn ntori_osd_finest_sizes(_: *const c_void, _: *mut i32, _: *mut i32) {}
+    pub unsafe extern "C" fn ntori_osd_finest_faces(_: *const c_void, _: *mut i32, _: *mut i32) {}
+    pub unsafe extern "C" fn ntori_osd_limit_positions(
+        _: *const c_void,
+        _: *const f64,
+        _: *mut f64,
+        _: *mut f64,
+        _: *mut f64,
+    ) -> i32 {
         0
     }
     pub unsafe extern "C" fn ntori_osd_uniform_stencils(_: *const c_void) -> *mut c_void {

@@ -286,13 +286,16 @@ fn measure_shape(fitted: &Fitted, diagonal: f64) -> Result<ShapeReport, embeddin
 impl ShapeReport {
     /// Whether the shape is one a designer would accept: see the tolerances.
     pub fn verdict(&self) -> ShapeVerdict {
-        let normal_tolerance = match self.normals_from {
-            NormalReference::Intended => NORMAL_TOLERANCE_INTENDED,
-            NormalReference::Mesh => NORMAL_TOLERANCE_MESH,
+        let (curvature_tolerance, normal_tolerance) = match self.normals_from {
+            NormalReference::Intended => (
+                CURVATURE_RATIO_TOLERANCE_INTENDED,
+                NORMAL_TOLERANCE_INTENDED,
+            ),
+            NormalReference::Mesh => (CURVATURE_RATIO_TOLERANCE_MESH, NORMAL_TOLERANCE_MESH),
         };
         ShapeVerdict {
             disagreement: self.patch_disagreement <= DISAGREEMENT_TOLERANCE,
-            curvature: self.curvature_ratio <= CURVATURE_RATIO_TOLERANCE,
+            curvature: self.curvature_ratio <= curvature_tolerance,
             normals: self.normal_deviation_p90 <= normal_tolerance,
             embedded: self.self_intersections == 0,
         }
@@ -332,8 +335,12 @@ pub const CURVATURE_TOLERANCE: f64 = 1e-3;
 pub const RESIDUAL_TOLERANCE: f64 = 0.01;
 /// Largest patch disagreement, as a fraction of the diagonal, the check accepts.
 pub const DISAGREEMENT_TOLERANCE: f64 = 0.01;
-/// Largest ratio of the surface's |κ| to the input's the check accepts: a crease or spike.
-pub const CURVATURE_RATIO_TOLERANCE: f64 = 3.0;
+/// Largest ratio of the surface's |κ| to the input's the check accepts (a crease or a spike), where
+/// the input's comes from the intended shape's exact normals, and where it comes from a mesh's own:
+/// those underestimate the peak of a coarse mesh, whose triangles each span much of a rim's turn
+/// (the 1581-vertex `assets/meshes/plate-genus-3.obj` reads 3.1 against its shape's 4.0).
+pub const CURVATURE_RATIO_TOLERANCE_INTENDED: f64 = 3.0;
+pub const CURVATURE_RATIO_TOLERANCE_MESH: f64 = 4.0;
 /// Largest 90th percentile of the normal deviation (degrees) the check accepts, against the
 /// intended shape's exact normals and against a mesh's own (which carry its faceting).
 pub const NORMAL_TOLERANCE_INTENDED: f64 = 5.0;

@@ -104,3 +104,165 @@ fn a_missing_mesh_is_named_before_the_output_is_checked() {
         "kept"
     );
 }
+
+/// Whether OpenSubdiv is linked (CI links it, and says so by NTORI_REQUIRE_TOOLS).
+fn opensubdiv() -> bool {
+    if !anchors::available() && std::env::var_os("NTORI_REQUIRE_TOOLS").is_some() {
+        panic!("NTORI_REQUIRE_TOOLS is set but OpenSubdiv is not linked");
+    }
+    anchors::available()
+}
+
+fn write_obj(path: &std::path::Path, positions: &[[f32; 3]], faces: &[Vec<u32>]) {
+    let mut text = String::new();
+    for p in positions {
+        text += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for f in faces {
+        let corners: Vec<String> = f.iter().map(|v| (v + 1).to_string()).collect();
+        text += &format!("f {}\n", corners.join(" "));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn a_subdivision_cage_fits_its_limit_surface() {
+    if !opensubdiv() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A genus-2 voxel slab of quads.
+    let cage = anchors::QuadMesh::genus_cage(2);
+    let path = dir.path().join("slab.obj");
+    let faces: Vec<Vec<u32>> = cage.faces.iter().map(|f| f.to_vec()).collect();
+    write_obj(&path, &cage.positions, &faces);
+    let out = ntori()
+        .args(["fit", "--cage", "--json", "-q", "-o"])
+        .arg(dir.path().join("slab.json"))
+        .arg(&path)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let (input, fit) = (&report["input"], &report["fit"]);
+    assert_eq!(fit["genus"], 2, "{report}");
+    assert_eq!(fit["passed"], true, "{report}");
+    assert_eq!(input["cage"]["faces"], cage.faces.len(), "{report}");
+    assert_eq!(input["cage"]["non_quads"], 0, "{report}");
+    // The fewest levels that make 12 000 triangles: after the first level a quad per corner of the
+    // cage (4 per quad), then 4 quads per quad, each cut in 2.
+    let level = input["cage"]["level"].as_u64().unwrap() as u32;
+    let triangles = |l: u32| 2 * 4 * cage.faces.len() * 4usize.pow(l - 1);
+    assert!(
+        triangles(level) >= 12_000 && triangles(level - 1) < 12_000,
+        "{report}"
+    );
+    assert_eq!(fit["mesh_triangles"], triangles(level), "{report}");
+    assert_eq!(fit["settings"]["grid"], 32, "{report}");
+    assert_eq!(
+        input["cage"]["limit_vertices"],
+        cage.refined_vertex_count(level as u32),
+        "{report}"
+    );
+    // The limit normals are the intended shape's, and the surface follows them.
+    assert_eq!(fit["shape"]["normals_from"], "intended", "{report}");
+    assert!(
+        fit["shape"]["normal_deviation_p90"].as_f64().unwrap() < 2.5,
+        "{report}"
+    );
+    assert!(fit["max_residual"].as_f64().unwrap() < 0.005, "{report}");
+}
+
+#[test]
+fn a_cage_with_pentagons_is_refined_and_fitted() {
+    if !opensubdiv() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A house (genus 0): a unit cube under a gabled roof of two quads, its two gable walls
+    // pentagons.
+    let positions = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+        [0.5, 0.0, 1.5],
+        [0.5, 1.0, 1.5],
+    ];
+    let faces = vec![
+        vec![0, 3, 2, 1],
+        vec![0, 1, 5, 8, 4],
+        vec![2, 3, 7, 9, 6],
+        vec![1, 2, 6, 5],
+        vec![3, 0, 4, 7],
+        vec![4, 8, 9, 7],
+        vec![5, 6, 9, 8],
+    ];
+    let path = dir.path().join("house.obj");
+    write_obj(&path, &positions, &faces);
+    let out = ntori()
+        .args(["fit", "--cage", "--cage-level", "4", "--json", "-q", "-o"])
+        .arg(dir.path().join("house.json"))
+        .arg(&path)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(report["fit"]["genus"], 0, "{report}");
+    assert_eq!(report["fit"]["passed"], true, "{report}");
+    assert_eq!(report["input"]["cage"]["non_quads"], 2, "{report}");
+    assert_eq!(report["input"]["cage"]["level"], 4, "{report}");
+    // After the first level one quad per corner of the cage (30 corners), then 4 per quad.
+    assert_eq!(report["fit"]["mesh_triangles"], 2 * 30 * 64, "{report}");
+}
+
+#[test]
+fn a_cage_whose_faces_disagree_is_refused_with_nothing_written() {
+    if !opensubdiv() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A cube with one face turned the other way.
+    let positions = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+    let faces = vec![
+        vec![0, 1, 2, 3],
+        vec![4, 5, 6, 7],
+        vec![0, 1, 5, 4],
+        vec![1, 2, 6, 5],
+        vec![2, 3, 7, 6],
+        vec![3, 0, 4, 7],
+    ];
+    let path = dir.path().join("cube.obj");
+    write_obj(&path, &positions, &faces);
+    let out = dir.path().join("cube.json");
+    ntori()
+        .args(["fit", "--cage", "-o"])
+        .arg(&out)
+        .arg(&path)
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("cube.obj as a subdivision cage"))
+        .stderr(predicate::str::contains("faces must agree in orientation"));
+    assert!(!out.exists());
+    // --cage-level needs --cage, and --cage does not take --largest.
+    for args in [&["--cage-level", "3"][..], &["--cage", "--largest"]] {
+        ntori().arg("fit").args(args).arg(&path).assert().code(2);
+    }
+}

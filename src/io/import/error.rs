@@ -174,6 +174,23 @@ pub enum ImportError {
     #[error("the mesh has more than {max} triangles{at}, the most ntori reads")]
     TooManyTriangles { at: Location, max: usize },
 
+    // ----- subdivision cages (`ntori fit --cage`)
+    #[error(
+        "as a subdivision cage its faces must agree in orientation, and {triangles} of its triangulated faces turn the other way"
+    )]
+    CageOrientation { triangles: usize },
+    #[error(
+        "refining the cage {level} times would make {triangles} triangles; the fit takes at most {max}, and at most {} levels",
+        super::cage::MAX_CAGE_LEVEL
+    )]
+    CageTooFine {
+        level: u32,
+        triangles: usize,
+        max: usize,
+    },
+    #[error("the subdivision cage cannot be refined: {0}")]
+    Subdivision(anchors::Error),
+
     // ----- validation
     #[error("the mesh has no triangles")]
     NoTriangles,

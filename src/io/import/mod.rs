@@ -36,6 +36,7 @@ use embedding::Point3;
 
 use crate::io::input::{self, InputProblem};
 
+pub mod cage;
 mod error;
 pub mod glb;
 pub mod obj;
@@ -127,6 +128,28 @@ pub struct ImportedMesh {
     pub merged_vertices: usize,
     /// Polygons with more than three sides that were cut into triangles.
     pub triangulated_polygons: usize,
+    /// The faces as the file gave them, before triangulation, numbered as `positions` (what a
+    /// subdivision cage is made of).
+    pub polygons: Polygons,
+}
+
+/// Polygons, flat: polygon f has `sides[f]` corners, the next ones of `corners`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Polygons {
+    pub sides: Vec<u32>,
+    pub corners: Vec<u32>,
+}
+
+impl Polygons {
+    /// Each polygon's corners in turn (stopping where `corners` runs out).
+    pub fn iter(&self) -> impl Iterator<Item = &[u32]> {
+        let mut start = 0;
+        self.sides.iter().map_while(move |&s| {
+            let polygon = self.corners.get(start..start + s as usize)?;
+            start += s as usize;
+            Some(polygon)
+        })
+    }
 }
 
 /// A mesh ready to fit: one closed, connected, consistently oriented manifold of genus 0..=64.
@@ -290,6 +313,10 @@ impl RawMesh {
             triangles,
             merged_vertices: 0,
             triangulated_polygons: triangulated,
+            polygons: Polygons {
+                sides: self.sides,
+                corners: self.corners,
+            },
         };
         if self.merge {
             merge_coincident(&mut mesh);
@@ -317,6 +344,9 @@ pub fn merge_coincident(mesh: &mut ImportedMesh) -> usize {
         .collect();
     for t in &mut mesh.triangles {
         *t = t.map(|v| remap[v as usize]);
+    }
+    for c in &mut mesh.polygons.corners {
+        *c = remap[*c as usize];
     }
     let merged = mesh.positions.len() - positions.len();
     mesh.positions = positions;
