@@ -31,6 +31,7 @@ use super::{FitArgs, spinner};
 /// Examples:
 ///   ntori fit assets/meshes/pretzel.obj -o pretzel.json
 ///   ntori fit scan.stl --largest --grid 16
+///   ntori fit assets/meshes/slab-genus-2-cage.obj --cage
 #[derive(clap::Args, Debug)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
@@ -281,7 +282,8 @@ impl Report for FitReport<'_> {
         if i.merged_vertices > 0 {
             notes.push(format!("{} coincident vertices merged", i.merged_vertices));
         }
-        if i.triangulated_polygons > 0 {
+        // A cage's polygons are triangulated only to be checked; its own line says what was made.
+        if i.triangulated_polygons > 0 && i.cage.is_none() {
             notes.push(format!("{} polygons triangulated", i.triangulated_polygons));
         }
         if i.dropped_components > 0 {
