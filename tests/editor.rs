@@ -975,6 +975,79 @@ fn a_new_model_of_another_genus_from_the_dialog() {
     assert_eq!(topology.euler_characteristic, 0);
 }
 
+/// File → Import mesh (Ctrl + I): the mesh is read, checked and fitted in the background as
+/// `ntori fit` fits it, and becomes an untitled model; a mesh that cannot be fitted is said, and the
+/// model on screen stays.
+#[test]
+fn an_imported_mesh_becomes_an_untitled_model() {
+    let _gpu = gpu_lock();
+    let mut harness = harness();
+    let import = |harness: &mut Harness<'static, EditorApp>, path: &std::path::Path| {
+        harness.key_press_modifiers(Modifiers::COMMAND, Key::I);
+        harness.run();
+        harness
+            .get_by_label("File:")
+            .set_text_value_accesskit(path.to_str().unwrap());
+        harness.run();
+        harness.get_by_label("Import").click();
+        harness.run_steps(2);
+        harness.state_mut().wait_for_job();
+        harness.run();
+    };
+    let dumbbell =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/dumbbell-genus-0.obj");
+    import(&mut harness, &dumbbell);
+    let messages = format!("{:?}", harness.state().messages());
+    let state = harness.state().state().unwrap();
+    assert_eq!(state.genus(), 0, "{messages}");
+    assert_eq!(state.path(), None, "{messages}");
+    assert!(!state.is_modified());
+    assert_eq!(
+        state.settings().grid,
+        embedding::mesh_fit::MESH_FIT_GRID,
+        "{messages}"
+    );
+    assert!(
+        messages.contains("imported") && messages.contains("genus 0"),
+        "{messages}"
+    );
+    // The surface is the one `ntori fit` makes: it passes within 1% of the mesh's vertices.
+    let mesh = ntori::io::import::read_mesh(&dumbbell).unwrap();
+    let size = embedding::bounding_box(&mesh.positions);
+    let diagonal = (size.1 - size.0).norm();
+    let surface = state.surface().clone();
+    let tessellation = surface.atlas().tessellate(24, 24).unwrap();
+    let positions: Vec<[f64; 3]> = tessellation
+        .vertices
+        .iter()
+        .map(|&p| surface.position(p).coords.into())
+        .collect();
+    let input: Vec<[f64; 3]> = mesh.positions.iter().map(|p| p.coords.into()).collect();
+    let distance = mesh::spatial::hausdorff(
+        mesh::spatial::MeshRef {
+            positions: &input,
+            triangles: &mesh.triangles,
+        },
+        mesh::spatial::MeshRef {
+            positions: &positions,
+            triangles: &tessellation.triangles,
+        },
+    )
+    .unwrap();
+    assert!(distance.symmetric < 0.01 * diagonal, "{distance:?}");
+    // An open mesh: the error names the file and the problem; the dumbbell stays.
+    let dir = tempfile::tempdir().unwrap();
+    let open = dir.path().join("open.obj");
+    std::fs::write(&open, "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n").unwrap();
+    import(&mut harness, &open);
+    let messages = format!("{:?}", harness.state().messages());
+    assert!(
+        messages.contains("open.obj") && messages.contains("not closed"),
+        "{messages}"
+    );
+    assert_eq!(harness.state().state().unwrap().genus(), 0);
+}
+
 #[test]
 fn every_style_and_a_control_net_drawn() {
     let _gpu = gpu_lock();

@@ -233,8 +233,10 @@ pub const MAX_FIT_TRIANGLES: usize = 200_000;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FitStage {
     Meshing,
-    /// Cutting the mesh open and flattening it onto the polygon.
-    Flattening,
+    /// Cutting the mesh of `triangles` triangles open and flattening it onto the polygon.
+    Flattening {
+        triangles: usize,
+    },
     /// Relaxing the map on the closed surface: round `round` of `rounds` (each up to the sweep cap).
     Relaxing {
         round: usize,
@@ -248,7 +250,9 @@ impl std::fmt::Display for FitStage {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             FitStage::Meshing => write!(f, "meshing the input"),
-            FitStage::Flattening => write!(f, "cutting and flattening the mesh"),
+            FitStage::Flattening { triangles } => {
+                write!(f, "cutting and flattening the mesh ({triangles} triangles)")
+            }
             FitStage::Relaxing { round, rounds } => {
                 write!(
                     f,
@@ -293,7 +297,9 @@ pub fn initial_model_with_progress(
             max: MAX_FIT_TRIANGLES,
         });
     }
-    progress(FitStage::Flattening);
+    progress(FitStage::Flattening {
+        triangles: mesh.triangles.len(),
+    });
     let parameterization = match atlas.polygon() {
         None => stereographic(&atlas, &mesh),
         Some(polygon) => flatten(

@@ -5,13 +5,13 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use embedding::fit::{FitStage, MAX_FIT_TRIANGLES};
-use embedding::mesh_fit::{MeshFit, mesh_model};
+use embedding::mesh_fit::{MESH_FIT_GRID, MeshFit, mesh_model};
 use ntori::io::import::{self, ValidMesh, cage};
 use serde::Serialize;
 
 use super::new::{Fitted, NewReport, check};
 use super::report::{Report, emit};
-use super::{FitArgs, spinner};
+use super::{FitArgs, FitProgress};
 
 /// Fit a smooth model to a closed mesh: OBJ, PLY, OFF, STL or GLB, of genus 0 to 64.
 ///
@@ -95,26 +95,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let default_grid = if cage.is_some() {
         embedding::SplineSettings::default().grid
     } else {
-        FIT_GRID
+        MESH_FIT_GRID
     };
     let (settings, fit) = args.spline.settings(default_grid);
-    let bar = spinner(args.quiet);
-    let progress = |stage: &str| {
-        bar.set_message(stage.to_string());
-        bar.tick();
-    };
+    let progress = FitProgress::new(args.quiet);
     let fitted = mesh_model(
         &valid.positions,
         &valid.triangles,
         settings,
         fit,
-        &|s: FitStage| progress(&s.to_string()),
+        &|s: FitStage| progress.fit_stage(s),
     )
     .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
     let mut checked = as_fitted(&fitted, &valid, settings, fit.smoothness);
     checked.intended_normals = cage.as_ref().map(|c| &c.normals[..]);
-    let report = check(&checked, start, &progress)?;
-    bar.finish_and_clear();
+    let report = check(&checked, start, &|s| progress.stage(s))?;
+    progress.finish();
     let written = report.passed || args.keep_failed;
     if written && args.force {
         ntori::io::model_file::save(&args.output, &fitted.surface)?;
@@ -138,16 +134,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     emit(&report, args.json)
 }
-
-/// `ntori fit`'s grid where none is given. Users' meshes are often far coarser than `new`'s
-/// plates, and a grid finer than the data overfits: at 32 the 1581-vertex
-/// `assets/meshes/plate-genus-3.obj` fitted with |κ| up to 178 and patches 1.9% of the diagonal
-/// apart, the dumbbell's normals turned 5.2° from its mesh's at the 90th percentile. Measured at
-/// 16 / 20 / 24 (release, defaults otherwise): the plate's patches 0.92% / 0.61% / 0.33% apart
-/// with the largest |κ| 3.0× / 2.4× / 2.9× its mesh's, the max residual 0.31% / 0.16% / 0.12%;
-/// the dumbbell's patches 0.27% / 0.13% / 0.27% apart, |κ| 2.0× / 2.0× / 2.4×. 20 is best or
-/// near it on every measure.
-const FIT_GRID: usize = 20;
 
 /// A cage read (its polygons checked as a closed oriented manifold) and replaced by its limit
 /// surface, which is checked in turn.

@@ -13,7 +13,7 @@ use ntori::io::export::{self, ExportOptions, Format};
 use serde::Serialize;
 
 use super::report::{Report, emit};
-use super::{FitArgs, GenusArg, spinner};
+use super::{FitArgs, FitProgress, GenusArg};
 
 /// Make a new model: a smooth genus-n surface fitted to an n-holed mesh, written as a model file.
 ///
@@ -102,12 +102,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
         None => None,
     };
-    let bar = spinner(quiet);
-    let made = make(genus, resolution as usize, settings, fit, &|stage| {
-        bar.set_message(stage.to_string());
-        bar.tick();
-    });
-    bar.finish_and_clear();
+    let progress = FitProgress::new(quiet);
+    let made = make(genus, resolution as usize, settings, fit, &progress);
+    progress.finish();
     let Made {
         surface: model,
         report,
@@ -433,13 +430,13 @@ pub struct Made {
     pub points: Vec<ChartPoint>,
 }
 
-/// Fits the model and checks it. `stage` is told what is being done.
+/// Fits the model and checks it. `progress` is told what is being done.
 pub fn make(
     genus: u32,
     resolution: usize,
     settings: SplineSettings,
     fit: FitSettings,
-    stage: &dyn Fn(&str),
+    progress: &FitProgress,
 ) -> Result<Made, embedding::EmbeddingError> {
     let start = std::time::Instant::now();
     let InitialFit {
@@ -449,7 +446,7 @@ pub fn make(
         rms_residual,
         max_residual,
         mesh_diagonal,
-    } = initial_model_with_progress(genus, resolution, settings, fit, &|s| stage(&s.to_string()))?;
+    } = initial_model_with_progress(genus, resolution, settings, fit, &|s| progress.fit_stage(s))?;
     let checked = Fitted {
         surface: &surface,
         genus,
@@ -463,7 +460,7 @@ pub fn make(
         settings,
         smoothness: fit.smoothness,
     };
-    let report = check(&checked, start, stage)?;
+    let report = check(&checked, start, &|s| progress.stage(s))?;
     Ok(Made {
         surface,
         report,

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use charts::ChartId;
 use egui::{Context, Key, Modifiers};
-use embedding::SplineSettings;
+use embedding::{SplineSettings, Surface};
 
 use super::app::EditorApp;
 use super::jobs::{JobOutput, JobResult};
@@ -21,6 +21,8 @@ use crate::render::{CurvatureKind, Style};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FileAction {
     Open,
+    /// A user's mesh, fitted into a new model.
+    Import,
     SaveAs,
     Export,
     Screenshot,
@@ -30,6 +32,7 @@ impl FileAction {
     pub fn title(self) -> &'static str {
         match self {
             FileAction::Open => "Open model",
+            FileAction::Import => "Import mesh",
             FileAction::SaveAs => "Save model as",
             FileAction::Export => "Export mesh",
             FileAction::Screenshot => "Save screenshot",
@@ -39,12 +42,16 @@ impl FileAction {
     pub fn button(self) -> &'static str {
         match self {
             FileAction::Open => "Open",
+            FileAction::Import => "Import",
             FileAction::SaveAs => "Save",
             FileAction::Export => "Export",
             FileAction::Screenshot => "Save",
         }
     }
 }
+
+/// The largest residual of an imported mesh's fit that is not said as an error (`ntori fit`'s).
+const IMPORT_RESIDUAL_TOLERANCE: f64 = 0.01;
 
 /// An action that drops unsaved changes, so waits for the answer to "save changes?".
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +60,8 @@ pub enum Pending {
     New(u32, SplineSettings),
     /// Open this file (None: ask for one).
     Open(Option<PathBuf>),
+    /// Fit this mesh into a new model (None: ask for one).
+    Import(Option<PathBuf>),
     Close,
     /// Recover the i-th recovery file offered.
     Recover(usize),
@@ -135,6 +144,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Ctrl + Shift + Z, Ctrl + Y", "redo"),
     ("Ctrl + N", "new model"),
     ("Ctrl + O", "open"),
+    (
+        "Ctrl + I",
+        "import a mesh (OBJ, PLY, OFF, STL, GLB) and fit it",
+    ),
     ("Ctrl + S", "save"),
     ("Ctrl + Shift + S", "save as"),
     ("Ctrl + E", "export the mesh"),
@@ -219,6 +232,7 @@ impl KeyContext {
                 (Key::S, true) => unless_busy(Command::AskFile(FileAction::SaveAs, None)),
                 (Key::S, false) => unless_busy(Command::Save(None)),
                 (Key::O, _) => unless_busy(Command::Guarded(Pending::Open(None))),
+                (Key::I, _) => unless_busy(Command::Guarded(Pending::Import(None))),
                 (Key::N, _) => {
                     unless_busy(Command::NewModelDialog(self.new_model.0, self.new_model.1))
                 }
@@ -283,6 +297,7 @@ impl EditorApp {
             }
             Command::FileChosen(action, path, then) => match action {
                 FileAction::Open => self.open_or_tell(&path),
+                FileAction::Import => self.jobs.import_mesh(path),
                 FileAction::SaveAs => self.save_as(&path, then),
                 FileAction::Export => {
                     if let Some(state) = &self.state {
@@ -368,6 +383,8 @@ impl EditorApp {
             Pending::New(genus, settings) => self.jobs.new_model(genus, settings),
             Pending::Open(Some(path)) => self.open_or_tell(&path),
             Pending::Open(None) => self.apply(Command::AskFile(FileAction::Open, None)),
+            Pending::Import(Some(path)) => self.jobs.import_mesh(path),
+            Pending::Import(None) => self.apply(Command::AskFile(FileAction::Import, None)),
             Pending::Close => {
                 self.allow_close = true;
                 self.close_now = true;
@@ -396,6 +413,40 @@ impl EditorApp {
                 }
             }
             Err(e) => self.messages.error(e.to_string()),
+        }
+    }
+
+    /// Shows an imported mesh's model (untitled: the mesh file is not a model file), and says how
+    /// well it fits: a fold or a residual over `ntori fit`'s 1% is said as an error, the model shown
+    /// all the same, to look at what went wrong.
+    fn finish_import(
+        &mut self,
+        path: &Path,
+        genus: u32,
+        surface: Surface,
+        max_residual: f64,
+        folded: usize,
+    ) {
+        let state = match EditorState::new(surface, self.current_meshing()) {
+            Ok(state) => state,
+            Err(e) => {
+                self.messages
+                    .error(format!("cannot show the imported model: {e}"));
+                return;
+            }
+        };
+        self.install(state);
+        let what = format!(
+            "imported {} (genus {genus}): the surface passes within {:.2}% of the mesh's size of its vertices",
+            path.display(),
+            100.0 * max_residual
+        );
+        if folded == 0 && max_residual <= IMPORT_RESIDUAL_TOLERANCE {
+            self.messages.info(what);
+        } else {
+            self.messages.error(format!(
+                "{what}, and the map folds {folded} triangles: the fit misses `ntori fit`'s checks (it says more)"
+            ));
         }
     }
 
@@ -432,6 +483,13 @@ impl EditorApp {
                         .error(format!("cannot show the new model: {e}")),
                 }
             }
+            Ok(JobOutput::Imported {
+                path,
+                genus,
+                surface,
+                max_residual,
+                folded,
+            }) => self.finish_import(&path, genus, surface, max_residual, folded),
             Ok(JobOutput::Refit {
                 settings,
                 control,

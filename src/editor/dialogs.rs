@@ -60,7 +60,7 @@ impl Dialogs {
     ) -> Option<Command> {
         if !self.native {
             let text = match action {
-                FileAction::Open => String::new(),
+                FileAction::Open | FileAction::Import => String::new(),
                 _ => suggested_name(current, action),
             };
             self.prompt = Some(Prompt { action, text, then });
@@ -74,12 +74,15 @@ impl Dialogs {
                 &crate::io::export::Format::ALL.map(crate::io::export::Format::extension),
             ),
             FileAction::Screenshot => dialog.add_filter("PNG image", &["png"]),
+            FileAction::Import => {
+                dialog.add_filter("Mesh", &crate::io::import::MeshFormat::EXTENSION_LIST)
+            }
         };
         if let Some(dir) = current.and_then(Path::parent) {
             dialog = dialog.set_directory(dir);
         }
         let chosen = match action {
-            FileAction::Open => dialog.pick_file(),
+            FileAction::Open | FileAction::Import => dialog.pick_file(),
             _ => dialog
                 .set_file_name(suggested_name(current, action))
                 .save_file(),
@@ -259,7 +262,7 @@ fn suggested_name(current: Option<&Path>, action: FileAction) -> String {
         .unwrap_or("model");
     match action {
         FileAction::Open | FileAction::SaveAs => format!("{stem}.json"),
-        FileAction::Export => format!("{stem}.obj"),
+        FileAction::Export | FileAction::Import => format!("{stem}.obj"),
         FileAction::Screenshot => format!("{stem}.png"),
     }
 }

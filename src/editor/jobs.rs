@@ -1,16 +1,18 @@
-//! Work done off the UI thread: fitting a new model, refitting to new spline settings, exporting the
-//! mesh. One job at a time; its result comes back through a channel, and the app applies it
+//! Work done off the UI thread: fitting a new model, importing a mesh (fitting it as `ntori fit`
+//! does), refitting to new spline settings, exporting the mesh. One job at a time; its result comes back through a channel, and the app applies it
 //! ([`super::commands::Command::JobDone`]).
 
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
-use embedding::fit::{FitSettings, initial_model, vertex_areas};
+use embedding::fit::{FitSettings, MAX_FIT_TRIANGLES, initial_model, vertex_areas};
+use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
 use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
 use super::state::EditorError;
 use crate::io::export::{self, ExportError, Format};
+use crate::io::import;
 
 /// Resolution of the input meshes of new models (points around each hole), as `ntori new` uses.
 const NEW_MODEL_RESOLUTION: usize = 32;
@@ -20,6 +22,15 @@ const NEW_MODEL_RESOLUTION: usize = 32;
 pub enum JobOutput {
     /// A new model was fitted.
     NewModel { genus: u32, surface: Surface },
+    /// A user's mesh was fitted: the largest distance from its vertices to the surface (a fraction
+    /// of its bounding-box diagonal) and the triangles the map folds (both 0 when all is well).
+    Imported {
+        path: PathBuf,
+        genus: u32,
+        surface: Surface,
+        max_residual: f64,
+        folded: usize,
+    },
     /// The control points for `settings`, and how far the refitted surface lies from the old one
     /// at most.
     Refit {
@@ -39,6 +50,14 @@ pub enum JobOutput {
 pub enum JobError {
     #[error("cannot make a genus-{genus} model: {source}")]
     NewModel { genus: u32, source: EmbeddingError },
+    /// The mesh could not be read or is not one a fit takes (the message names the file).
+    #[error("cannot import: {0}")]
+    Import(String),
+    #[error("cannot fit {}: {source}", .path.display())]
+    ImportFit {
+        path: PathBuf,
+        source: EmbeddingError,
+    },
     #[error("cannot refit: {0}")]
     Refit(#[source] EditorError),
     #[error("export failed: {0}")]
@@ -96,6 +115,48 @@ impl Jobs {
             Ok(JobOutput::NewModel {
                 genus,
                 surface: fit.surface,
+            })
+        });
+    }
+
+    /// Reads, checks and fits the mesh at `path` (as `ntori fit` does, with its default grid).
+    pub fn import_mesh(&mut self, path: PathBuf) {
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        self.spawn(format!("importing {name}"), move || {
+            let read = import::read_mesh(&path).map_err(|e| JobError::Import(e.to_string()))?;
+            let valid = import::validate(read, false)
+                .map_err(|e| JobError::Import(format!("{}: {e}", path.display())))?;
+            if valid.triangles.len() > MAX_FIT_TRIANGLES {
+                return Err(JobError::Import(format!(
+                    "{}: it has {} triangles, and the fit takes at most {MAX_FIT_TRIANGLES} (decimate it first)",
+                    path.display(),
+                    valid.triangles.len()
+                )));
+            }
+            let settings = SplineSettings {
+                grid: MESH_FIT_GRID,
+                ..SplineSettings::default()
+            };
+            let fit = mesh_model(
+                &valid.positions,
+                &valid.triangles,
+                settings,
+                FitSettings::default(),
+                &|_| {},
+            )
+            .map_err(|source| JobError::ImportFit {
+                path: path.clone(),
+                source,
+            })?;
+            Ok(JobOutput::Imported {
+                max_residual: fit.max_residual / fit.mesh_diagonal,
+                folded: fit.parameterization.folded,
+                genus: fit.genus,
+                surface: fit.surface,
+                path,
             })
         });
     }

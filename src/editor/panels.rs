@@ -115,6 +115,12 @@ pub fn menu_bar(
                     "Ctrl+O",
                     Command::Guarded(Pending::Open(None)),
                 ),
+                (
+                    !busy,
+                    "Import mesh…",
+                    "Ctrl+I",
+                    Command::Guarded(Pending::Import(None)),
+                ),
                 (has && !busy, "Save", "Ctrl+S", Command::Save(None)),
                 (
                     has && !busy,

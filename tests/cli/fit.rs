@@ -163,7 +163,7 @@ fn a_subdivision_cage_fits_its_limit_surface() {
     assert_eq!(fit["settings"]["grid"], 32, "{report}");
     assert_eq!(
         input["cage"]["limit_vertices"],
-        cage.refined_vertex_count(level as u32),
+        cage.refined_vertex_count(level),
         "{report}"
     );
     // The limit normals are the intended shape's, and the surface follows them.

@@ -253,7 +253,11 @@ fn the_fit_reports_its_stages_in_order() {
             seen.borrow_mut().push(s)
         })
         .unwrap();
-        let mut expected = vec![FitStage::Meshing, FitStage::Flattening];
+        let triangles = embedding::holed::HoledMesh::new(genus, 12)
+            .unwrap()
+            .triangles
+            .len();
+        let mut expected = vec![FitStage::Meshing, FitStage::Flattening { triangles }];
         if genus > 0 {
             let rounds = fit_settings.stretch_rounds + 1;
             expected.extend((1..=rounds).map(|round| FitStage::Relaxing { round, rounds }));

@@ -917,3 +917,21 @@ fn fuzz_mesh_readers() {
     eprintln!("fuzz_mesh_readers: outcomes {:?}", outcomes.into_inner());
     result.unwrap();
 }
+
+#[test]
+fn the_dialog_extension_list_is_what_the_readers_take() {
+    for extension in MeshFormat::EXTENSION_LIST {
+        assert!(
+            MeshFormat::from_extension(extension).is_some(),
+            "{extension}"
+        );
+        assert!(
+            MeshFormat::EXTENSIONS.contains(&format!(".{extension}")),
+            "{extension}"
+        );
+    }
+    assert_eq!(
+        MeshFormat::EXTENSIONS.matches('.').count(),
+        MeshFormat::EXTENSION_LIST.len()
+    );
+}

@@ -80,6 +80,8 @@ pub enum MeshFormat {
 impl MeshFormat {
     /// The extensions read, as listed in messages.
     pub const EXTENSIONS: &'static str = ".obj, .ply, .off, .stl, .glb and .gltf";
+    /// The same, for file dialogs' filters (what [`MeshFormat::from_extension`] takes).
+    pub const EXTENSION_LIST: [&'static str; 6] = ["obj", "ply", "off", "stl", "glb", "gltf"];
 
     /// The format of a file name's extension (case-insensitive).
     pub fn from_extension(extension: &str) -> Option<MeshFormat> {
