@@ -264,6 +264,25 @@ impl std::fmt::Display for FitStage {
     }
 }
 
+/// The input mesh's resolution where none is chosen (points round each hole).
+pub const DEFAULT_RESOLUTION: usize = 32;
+
+/// The resolution `ntori new` and the editor use for `genus`: [`DEFAULT_RESOLUTION`], or where that
+/// mesh has more triangles than the fit takes ([`MAX_FIT_TRIANGLES`]; genus 24 and 32, not 16),
+/// nearly the finest that fits (the plates' triangles grow as the resolution's square): genus 24
+/// gets 28, 32 gets 21. Where even resolution 8 is too fine, 8, which the fit then refuses.
+pub fn default_resolution(genus: u32) -> Result<usize, EmbeddingError> {
+    let mut resolution = DEFAULT_RESOLUTION;
+    loop {
+        let triangles = HoledMesh::new(genus, resolution)?.triangles.len();
+        if triangles <= MAX_FIT_TRIANGLES || resolution <= 8 {
+            return Ok(resolution);
+        }
+        let scale = (MAX_FIT_TRIANGLES as f64 / triangles as f64).sqrt();
+        resolution = ((0.97 * scale * resolution as f64) as usize).clamp(8, resolution - 1);
+    }
+}
+
 /// The whole pipeline: mesh (at `resolution`), cut, flatten, fit. Refuses, before the fit
 /// allocates anything, an input mesh of more than [`MAX_FIT_TRIANGLES`] triangles
 /// ([`EmbeddingError::FitTooLarge`]).

@@ -58,10 +58,11 @@ pub struct Args {
     /// as `ntori export` places it by default).
     #[arg(long, value_name = "FILE")]
     input_mesh: Option<PathBuf>,
-    /// Input mesh resolution: points around each hole (around the equator for the sphere).
-    #[arg(long, default_value_t = 32, value_name = "R",
-          value_parser = clap::value_parser!(u64).range(8..=1024))]
-    resolution: u64,
+    /// Input mesh resolution: points around each hole (around the equator for the sphere)
+    /// [default: 32, or for high genus nearly the finest whose mesh the fit takes: 28 at genus 24,
+    /// 21 at genus 32].
+    #[arg(long, value_name = "R", value_parser = clap::value_parser!(u64).range(8..=1024))]
+    resolution: Option<u64>,
     #[command(flatten)]
     spline: FitArgs,
     /// Print the report as JSON.
@@ -103,7 +104,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => None,
     };
     let progress = FitProgress::new(quiet);
-    let made = make(genus, resolution as usize, settings, fit, &progress);
+    let resolution = match resolution {
+        Some(r) => r as usize,
+        None => embedding::fit::default_resolution(genus)
+            .with_context(|| format!("cannot make a genus-{genus} model"))?,
+    };
+    let made = make(genus, resolution, settings, fit, &progress);
     progress.finish();
     let Made {
         surface: model,

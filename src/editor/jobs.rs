@@ -6,16 +6,15 @@ use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
-use embedding::fit::{FitSettings, MAX_FIT_TRIANGLES, initial_model, vertex_areas};
+use embedding::fit::{
+    FitSettings, MAX_FIT_TRIANGLES, default_resolution, initial_model, vertex_areas,
+};
 use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
 use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
 use super::state::EditorError;
 use crate::io::export::{self, ExportError, Format};
 use crate::io::import;
-
-/// Resolution of the input meshes of new models (points around each hole), as `ntori new` uses.
-const NEW_MODEL_RESOLUTION: usize = 32;
 
 /// What a finished job produced.
 #[derive(Debug)]
@@ -105,13 +104,11 @@ impl Jobs {
     /// Fits a new model of `genus` (as `ntori new` does).
     pub fn new_model(&mut self, genus: u32, settings: SplineSettings) {
         self.spawn(format!("fitting a new genus-{genus} model"), move || {
-            let fit = initial_model(
-                genus,
-                NEW_MODEL_RESOLUTION,
-                settings,
-                FitSettings::default(),
-            )
-            .map_err(|source| JobError::NewModel { genus, source })?;
+            let fail = |source| JobError::NewModel { genus, source };
+            // The input mesh's resolution as `ntori new` chooses it.
+            let resolution = default_resolution(genus).map_err(fail)?;
+            let fit =
+                initial_model(genus, resolution, settings, FitSettings::default()).map_err(fail)?;
             Ok(JobOutput::NewModel {
                 genus,
                 surface: fit.surface,

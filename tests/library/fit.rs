@@ -408,3 +408,22 @@ fn a_system_the_sparse_qr_cannot_factor_is_solved_by_the_normal_equations() {
         sums.gaussian_curvature
     );
 }
+
+/// Without a chosen resolution, high genus gets the finest mesh the fit takes, not a refusal.
+#[test]
+fn the_default_resolution_keeps_high_genus_within_the_fit() {
+    use embedding::fit::{DEFAULT_RESOLUTION, MAX_FIT_TRIANGLES, default_resolution};
+    for genus in [0, 2, 8, 16] {
+        assert_eq!(default_resolution(genus).unwrap(), DEFAULT_RESOLUTION);
+    }
+    for genus in [24, 32] {
+        let resolution = default_resolution(genus).unwrap();
+        let triangles = HoledMesh::new(genus, resolution).unwrap().triangles.len();
+        eprintln!("genus {genus}: resolution {resolution}, {triangles} triangles");
+        assert!(resolution < DEFAULT_RESOLUTION, "genus {genus}");
+        assert!(
+            triangles <= MAX_FIT_TRIANGLES && 10 * triangles >= 8 * MAX_FIT_TRIANGLES,
+            "genus {genus}: {triangles} triangles at resolution {resolution}"
+        );
+    }
+}
