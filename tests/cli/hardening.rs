@@ -911,6 +911,14 @@ fn mesh_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
         ("TWO", file("two.obj", obj_text(&two).as_bytes())),
         ("SLIVER", file("sliver.obj", obj_text(&sliver).as_bytes())),
         ("FLAT", file("flat.obj", obj_text(&flat).as_bytes())),
+        (
+            "CAGE_TURNED",
+            file(
+                "cage-turned.obj",
+                b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+                  f 1 2 3 4\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+            ),
+        ),
     ]
     .into_iter()
     .map(|(name, path)| (format!("MESH_{name}"), path))

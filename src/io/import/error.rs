@@ -176,7 +176,7 @@ pub enum ImportError {
 
     // ----- subdivision cages (`ntori fit --cage`)
     #[error(
-        "as a subdivision cage its faces must agree in orientation, and {triangles} of its triangulated faces turn the other way"
+        "a cage is refined as its faces are given, so they must agree in orientation, and {triangles} of its triangles (its faces cut) turn the other way"
     )]
     CageOrientation { triangles: usize },
     #[error(
