@@ -89,16 +89,19 @@ impl Refiner {
 
     /// Refines uniformly to `level` (1 to 8) and returns the finest level's mesh with every vertex
     /// moved to its place on the limit surface of the cage whose vertices are at `base` (one per
-    /// base vertex). After one level every face of a Catmull–Clark mesh is a quad.
+    /// base vertex). After one level every face of a Catmull–Clark mesh is a quad. The refiner is
+    /// used up: a refiner refined before (by any call) is refused.
     pub fn limit_mesh(&self, level: u32, base: &[[f64; 3]]) -> Result<LimitMesh, Error> {
         if base.len() != self.base_vertices {
             return Err(Error::Failed("match the positions to the cage's vertices"));
         }
-        let level = level.clamp(1, 8);
-        // SAFETY: raw is a live refiner.
+        if !(1..=8).contains(&level) {
+            return Err(Error::Failed("refine to a level from 1 to 8"));
+        }
+        // SAFETY: raw is a live refiner; the shim refuses one refined before.
         let vertices = unsafe { sys::ntori_osd_refine_uniform_full(self.raw, level as i32) };
         if vertices <= 0 {
-            return Err(Error::Failed("refine uniformly"));
+            return Err(Error::Failed("refine uniformly (once, from the cage)"));
         }
         let (mut faces, mut corners) = (0i32, 0i32);
         // SAFETY: raw is refined; the two outputs are plain ints.
@@ -106,21 +109,34 @@ impl Refiner {
         if corners != 4 * faces {
             return Err(Error::Failed("refine to quads"));
         }
-        let mut counts = vec![0i32; faces as usize];
-        let mut indices = vec![0i32; corners as usize];
-        // SAFETY: counts and indices have the sizes the shim just reported.
-        unsafe { sys::ntori_osd_finest_faces(self.raw, counts.as_mut_ptr(), indices.as_mut_ptr()) };
+        let mut counts = vec![0i32; faces.max(0) as usize];
+        let mut indices = vec![0i32; corners.max(0) as usize];
+        // SAFETY: the shim writes at most `faces` counts and `corners` indices, the lengths given.
+        let ok = unsafe {
+            sys::ntori_osd_finest_faces(
+                self.raw,
+                counts.as_mut_ptr(),
+                faces,
+                indices.as_mut_ptr(),
+                corners,
+            )
+        };
+        if ok != 1 {
+            return Err(Error::Failed("read the refined faces"));
+        }
         let mut positions = vec![[0.0f64; 3]; vertices as usize];
         let (mut du, mut dv) = (positions.clone(), positions.clone());
-        // SAFETY: base holds base_vertices points; positions, du and dv one per finest vertex; each
-        // point is three doubles, as the shim reads and writes them.
+        // SAFETY: base holds base_vertices points; positions, du and dv `vertices` points each;
+        // every point is three doubles; the shim checks both counts against the refiner's levels.
         let ok = unsafe {
             sys::ntori_osd_limit_positions(
                 self.raw,
                 base.as_flattened().as_ptr(),
+                int(base.len())?,
                 positions.as_flattened_mut().as_mut_ptr(),
                 du.as_flattened_mut().as_mut_ptr(),
                 dv.as_flattened_mut().as_mut_ptr(),
+                vertices,
             )
         };
         if ok != 1 {
@@ -554,6 +570,26 @@ mod tests {
                     .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
             );
         }
+    }
+
+    /// A refiner refined before is refused, not read past its levels.
+    #[test]
+    fn a_refiner_is_refined_for_a_limit_mesh_once() {
+        if !linked() {
+            return;
+        }
+        let cage = QuadMesh::genus_cage(1);
+        let base: Vec<[f64; 3]> = cage.positions.iter().map(|p| p.map(f64::from)).collect();
+        let refiner = Refiner::new(&cage).unwrap();
+        refiner.limit_mesh(3, &base).unwrap();
+        assert!(refiner.limit_mesh(2, &base).is_err());
+        assert!(refiner.limit_mesh(4, &base).is_err());
+        let refiner = Refiner::new(&cage).unwrap();
+        refiner.refine_adaptive(2).unwrap();
+        assert!(refiner.limit_mesh(2, &base).is_err());
+        let refiner = Refiner::new(&cage).unwrap();
+        assert!(refiner.limit_mesh(0, &base).is_err());
+        assert!(refiner.limit_mesh(2, &base[1..]).is_err());
     }
 
     #[test]

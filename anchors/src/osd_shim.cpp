@@ -5,6 +5,7 @@
 // side can time the factories apart from refinement. Every entry point catches C++ exceptions and
 // reports failure as a null pointer or a zero return; none of them throws into Rust.
 
+#include <opensubdiv/far/error.h>
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/stencilTable.h>
 #include <opensubdiv/far/stencilTableFactory.h>
@@ -26,11 +27,20 @@ struct Table {
 
 }  // namespace
 
+namespace {
+void quiet_error(Far::ErrorType, const char *) {}
+void quiet_warning(const char *) {}
+}  // namespace
+
 extern "C" {
 
 // A Catmull-Clark refiner over a closed polygon mesh (`counts[f]` corners for face f, their vertex
 // indices in `indices`, faces in order).
 void *ntori_osd_refiner_new(int vertices, int faces, const int *counts, const int *indices) {
+    // OpenSubdiv prints its errors and warnings to stdout by default, where they would mix with a
+    // command's report; the calls here report failure by their results instead.
+    Far::SetErrorCallback(quiet_error);
+    Far::SetWarningCallback(quiet_warning);
     try {
         typedef Far::TopologyDescriptor Descriptor;
         Sdc::Options options;
@@ -207,13 +217,16 @@ struct Point64 {
 }  // namespace
 
 // Uniform refinement to `level` keeping the finest level's whole topology (its faces, and the
-// neighbourhoods the limit masks need); returns that level's vertex count, 0 on failure.
+// neighbourhoods the limit masks need); returns that level's vertex count, 0 on failure or when
+// the refiner was refined before (OpenSubdiv would then keep its earlier levels).
 int ntori_osd_refine_uniform_full(void *refiner, int level) {
     try {
         Far::TopologyRefiner *r = static_cast<Far::TopologyRefiner *>(refiner);
+        if (level < 1 || r->GetMaxLevel() != 0) return 0;
         Far::TopologyRefiner::UniformOptions options(level);
         options.fullTopologyInLastLevel = true;
         r->RefineUniform(options);
+        if (!r->IsUniform() || r->GetMaxLevel() != level) return 0;
         return r->GetLevel(level).GetNumVertices();
     } catch (...) {
         return 0;
@@ -229,24 +242,34 @@ void ntori_osd_finest_sizes(const void *refiner, int *faces, int *corners) {
 }
 
 // The finest level's faces: `counts[f]` corners for face f, their vertex indices in `indices`.
-void ntori_osd_finest_faces(const void *refiner, int *counts, int *indices) {
+// 1 on success, 0 if the arrays (`faces` and `corners` long) do not match the level.
+int ntori_osd_finest_faces(const void *refiner, int *counts, int faces, int *indices, int corners) {
     Far::TopologyRefiner const *r = static_cast<Far::TopologyRefiner const *>(refiner);
     Far::TopologyLevel const &level = r->GetLevel(r->GetMaxLevel());
+    if (level.GetNumFaces() != faces || level.GetNumFaceVertices() != corners) return 0;
     int k = 0;
-    for (int f = 0; f < level.GetNumFaces(); ++f) {
-        Far::ConstIndexArray corners = level.GetFaceVertices(f);
-        counts[f] = corners.size();
-        for (int c = 0; c < corners.size(); ++c) indices[k++] = corners[c];
+    for (int f = 0; f < faces; ++f) {
+        Far::ConstIndexArray face = level.GetFaceVertices(f);
+        if (k + face.size() > corners) return 0;
+        counts[f] = face.size();
+        for (int c = 0; c < face.size(); ++c) indices[k++] = face[c];
     }
+    return 1;
 }
 
 // The limit positions of the finest level's vertices (after ntori_osd_refine_uniform_full), from
-// the base mesh's positions (x, y, z each): interpolated level by level, then taken to the limit,
-// with two limit tangents per vertex into `du` and `dv`. 1 on success.
-int ntori_osd_limit_positions(const void *refiner, const double *base, double *out, double *du,
-                              double *dv) {
+// the base mesh's `base_count` positions (x, y, z each): interpolated level by level, then taken
+// to the limit, with two limit tangents per vertex into `du` and `dv` (each, like `out`,
+// `out_count` points). 1 on success, 0 if the counts do not match the refiner's levels or it was
+// not refined uniformly.
+int ntori_osd_limit_positions(const void *refiner, const double *base, int base_count, double *out,
+                              double *du, double *dv, int out_count) {
     try {
         Far::TopologyRefiner const *r = static_cast<Far::TopologyRefiner const *>(refiner);
+        if (!r->IsUniform() || r->GetMaxLevel() < 1 ||
+            r->GetLevel(0).GetNumVertices() != base_count ||
+            r->GetLevel(r->GetMaxLevel()).GetNumVertices() != out_count)
+            return 0;
         // Weights in double too, so the limit points carry no float rounding.
         Far::PrimvarRefinerReal<double> primvar(*r);
         int levels = r->GetMaxLevel();

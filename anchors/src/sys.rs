@@ -22,13 +22,21 @@ mod linked {
         pub fn ntori_osd_refine_adaptive(refiner: *mut c_void, level: i32) -> i32;
         pub fn ntori_osd_refine_uniform_full(refiner: *mut c_void, level: i32) -> i32;
         pub fn ntori_osd_finest_sizes(refiner: *const c_void, faces: *mut i32, corners: *mut i32);
-        pub fn ntori_osd_finest_faces(refiner: *const c_void, counts: *mut i32, indices: *mut i32);
+        pub fn ntori_osd_finest_faces(
+            refiner: *const c_void,
+            counts: *mut i32,
+            faces: i32,
+            indices: *mut i32,
+            corners: i32,
+        ) -> i32;
         pub fn ntori_osd_limit_positions(
             refiner: *const c_void,
             base: *const f64,
+            base_count: i32,
             out: *mut f64,
             du: *mut f64,
             dv: *mut f64,
+            out_count: i32,
         ) -> i32;
         pub fn ntori_osd_uniform_stencils(refiner: *const c_void) -> *mut c_void;
         pub fn ntori_osd_limit_stencils(
@@ -94,13 +102,23 @@ mod missing {
         0
     }
     pub unsafe extern "C" fn ntori_osd_finest_sizes(_: *const c_void, _: *mut i32, _: *mut i32) {}
-    pub unsafe extern "C" fn ntori_osd_finest_faces(_: *const c_void, _: *mut i32, _: *mut i32) {}
+    pub unsafe extern "C" fn ntori_osd_finest_faces(
+        _: *const c_void,
+        _: *mut i32,
+        _: i32,
+        _: *mut i32,
+        _: i32,
+    ) -> i32 {
+        0
+    }
     pub unsafe extern "C" fn ntori_osd_limit_positions(
         _: *const c_void,
         _: *const f64,
+        _: i32,
         _: *mut f64,
         _: *mut f64,
         _: *mut f64,
+        _: i32,
     ) -> i32 {
         0
     }

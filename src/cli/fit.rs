@@ -124,7 +124,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             triangulated_polygons: triangulated,
             dropped_components: valid.dropped_components,
             reoriented_triangles: valid.reoriented_triangles,
-            flipped: valid.flipped,
+            // A cage is turned (if at all) before it is refined, and its limit mesh comes out
+            // outward: what was done to the file is the cage's.
+            flipped: cage.as_ref().map_or(valid.flipped, |c| c.report.flipped),
             cage: cage.map(|c| c.report),
         },
         loops: LoopsReport::of(&fitted),
@@ -158,6 +160,8 @@ fn read_cage(
                 non_quads: limit.cage_non_quads,
                 level: limit.level,
                 limit_vertices: vertices,
+                flipped: limit.flipped,
+                unused_vertices: limit.unused_vertices,
             },
         },
     ))
@@ -177,6 +181,10 @@ struct CageReport {
     /// Levels of uniform refinement, and the vertices of the limit mesh they made.
     level: u32,
     limit_vertices: usize,
+    /// Whether the cage was inside out (turned before it was refined), and its vertices no face
+    /// uses (left out).
+    flipped: bool,
+    unused_vertices: usize,
 }
 
 /// Meshes beyond the fit's size are refused before any work.
@@ -283,6 +291,14 @@ impl Report for FitReport<'_> {
         }
         if i.flipped {
             notes.push("turned right side out".to_string());
+        }
+        if let Some(unused) = i
+            .cage
+            .as_ref()
+            .map(|c| c.unused_vertices)
+            .filter(|&u| u > 0)
+        {
+            notes.push(format!("{unused} vertices no face uses left out"));
         }
         let notes = if notes.is_empty() {
             String::new()

@@ -34,7 +34,7 @@ use super::{FitArgs, FitProgress, GenusArg};
 /// against the input's own, estimated on the mesh (a crease or spike; at most 3×); the angle
 /// between the surface's normal and the intended shape's exact normal at the input mesh's vertices
 /// (median and 90th percentile; at most 5° at the 90th); and crossing triangles of the
-/// t_e = t_r = 32 tessellation (none).
+/// t_e = t_r = 32 tessellation, or of 48 or 64 where 32's triangles are too coarse to tell (none).
 ///
 /// Examples:
 ///   ntori new                                 genus 2, written to model.json
@@ -548,7 +548,7 @@ impl NewReport {
             crossings = self.shape.self_intersections,
             t = self.shape.intersection_samples,
             ev = verdict(self.shape_verdict.embedded),
-            coarse = if self.shape.coarse_crossings > 0 {
+            coarse = if self.shape.coarse_crossings > 0 && self.shape.self_intersections == 0 {
                 format!(
                     "; {} at {}, whose triangles are coarse",
                     self.shape.coarse_crossings, INTERSECTION_SAMPLES[0]

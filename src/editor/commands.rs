@@ -418,7 +418,8 @@ impl EditorApp {
 
     /// Shows an imported mesh's model (untitled: the mesh file is not a model file), and says how
     /// well it fits: a fold or a residual over `ntori fit`'s 1% is said as an error, the model shown
-    /// all the same, to look at what went wrong.
+    /// all the same, to look at what went wrong. (Gauss–Bonnet and the shape checks are
+    /// `ntori fit`'s alone.)
     fn finish_import(
         &mut self,
         path: &Path,
@@ -441,11 +442,22 @@ impl EditorApp {
             path.display(),
             100.0 * max_residual
         );
-        if folded == 0 && max_residual <= IMPORT_RESIDUAL_TOLERANCE {
+        let mut missed = Vec::new();
+        if folded > 0 {
+            missed.push(format!("the map folds {folded} triangles"));
+        }
+        if max_residual > IMPORT_RESIDUAL_TOLERANCE {
+            missed.push(format!(
+                "the residual is over {:.0}%",
+                100.0 * IMPORT_RESIDUAL_TOLERANCE
+            ));
+        }
+        if missed.is_empty() {
             self.messages.info(what);
         } else {
             self.messages.error(format!(
-                "{what}, and the map folds {folded} triangles: the fit misses `ntori fit`'s checks (it says more)"
+                "{what}, but {}: `ntori fit` refuses this fit (and says more)",
+                missed.join(" and ")
             ));
         }
     }

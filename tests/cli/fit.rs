@@ -220,8 +220,39 @@ fn a_cage_with_pentagons_is_refined_and_fitted() {
     assert_eq!(report["fit"]["passed"], true, "{report}");
     assert_eq!(report["input"]["cage"]["non_quads"], 2, "{report}");
     assert_eq!(report["input"]["cage"]["level"], 4, "{report}");
+    assert_eq!(report["input"]["flipped"], false, "{report}");
     // After the first level one quad per corner of the cage (30 corners), then 4 per quad.
     assert_eq!(report["fit"]["mesh_triangles"], 2 * 30 * 64, "{report}");
+    let volume = report["fit"]["area"].as_f64().unwrap();
+
+    // The same house inside out, with a vertex no face uses: turned, the vertex left out, and the
+    // same limit surface.
+    let mut stray = positions.to_vec();
+    stray.push([5.0, 5.0, 5.0]);
+    let reversed: Vec<Vec<u32>> = faces
+        .iter()
+        .map(|f| f.iter().rev().copied().collect())
+        .collect();
+    let inside_out = dir.path().join("inside-out.obj");
+    write_obj(&inside_out, &stray, &reversed);
+    let out = ntori()
+        .args(["fit", "--cage", "--cage-level", "4", "--json", "-q", "-o"])
+        .arg(dir.path().join("inside-out.json"))
+        .arg(&inside_out)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(report["input"]["flipped"], true, "{report}");
+    assert_eq!(report["input"]["cage"]["flipped"], true, "{report}");
+    assert_eq!(report["input"]["cage"]["unused_vertices"], 1, "{report}");
+    let again = report["fit"]["area"].as_f64().unwrap();
+    assert!(
+        (again - volume).abs() < 1e-6 * volume,
+        "{again} vs {volume}"
+    );
 }
 
 #[test]

@@ -28,6 +28,10 @@ pub struct LimitSurface {
     pub cage_non_quads: usize,
     /// Levels of uniform refinement.
     pub level: u32,
+    /// Whether the cage was inside out (its faces were then turned), and how many of its vertices
+    /// no face uses (left out).
+    pub flipped: bool,
+    pub unused_vertices: usize,
 }
 
 /// The limit surface of `cage`, whose triangulation passed validation as `valid` (closed, one
@@ -43,6 +47,16 @@ pub fn limit_surface(
             triangles: valid.reoriented_triangles,
         });
     }
+    // Polygons as a reader made them add up; a hand-made `ImportedMesh` might not.
+    let total: usize = cage.polygons.sides.iter().map(|&s| s as usize).sum();
+    let n = cage.positions.len();
+    if total != cage.polygons.corners.len()
+        || cage.polygons.corners.iter().any(|&c| c as usize >= n)
+    {
+        return Err(ImportError::Subdivision(anchors::Error::Failed(
+            "read the cage's polygons (corner counts or indices out of range)",
+        )));
+    }
     // The cage's faces, outward, over the vertices they use (the unused are left out, as OpenSubdiv
     // would give them no limit point).
     let mut polygons = cage.polygons.clone();
@@ -56,15 +70,16 @@ pub fn limit_surface(
     let (positions, corners) = used_vertices(&cage.positions, &polygons);
     let corner_count: usize = polygons.sides.iter().map(|&s| s as usize).sum();
     let level = level.unwrap_or_else(|| default_level(corner_count));
-    // After the first level every face is a quad: one per corner of the cage, then 4× per level.
-    let quads = corner_count.saturating_mul(1usize << (2 * (level.saturating_sub(1)).min(30)));
-    if level > MAX_CAGE_LEVEL || 2 * quads > MAX_FIT_TRIANGLES {
+    if !(1..=MAX_CAGE_LEVEL).contains(&level)
+        || triangles_at(corner_count, level) > MAX_FIT_TRIANGLES
+    {
         return Err(ImportError::CageTooFine {
             level,
-            triangles: 2 * quads,
+            triangles: triangles_at(corner_count, level),
             max: MAX_FIT_TRIANGLES,
         });
     }
+    let unused_vertices = cage.positions.len() - positions.len();
     let refiner = anchors::Refiner::from_polygons(positions.len(), &polygons.sides, &corners)
         .map_err(ImportError::Subdivision)?;
     let base: Vec<[f64; 3]> = positions.iter().map(|p| [p.x, p.y, p.z]).collect();
@@ -95,15 +110,29 @@ pub fn limit_surface(
         normals,
         cage_faces: polygons.sides.len(),
         cage_non_quads: polygons.sides.iter().filter(|&&s| s != 4).count(),
+        flipped: valid.flipped,
+        unused_vertices,
         level,
     })
 }
 
-/// The fewest levels from 2 whose quads (`corners` · 4^(level − 1)) make [`CAGE_TRIANGLES`].
+/// Triangles after `level` levels: after the first every face is a quad, one per corner of the
+/// cage, then each level makes four of each; each quad is cut in two.
+fn triangles_at(corners: usize, level: u32) -> usize {
+    let per_corner = 1usize << (2 * level.clamp(1, 16) - 2);
+    corners.saturating_mul(per_corner).saturating_mul(2)
+}
+
+/// The fewest levels from 2 that make [`CAGE_TRIANGLES`], or, for a cage so fine that this is
+/// more than the fit takes, the most that fit (down to 1).
 fn default_level(corners: usize) -> u32 {
-    (2..MAX_CAGE_LEVEL)
-        .find(|&l| 2 * corners * (1 << (2 * (l - 1))) >= CAGE_TRIANGLES)
-        .unwrap_or(MAX_CAGE_LEVEL)
+    let wanted = (2..MAX_CAGE_LEVEL)
+        .find(|&l| triangles_at(corners, l) >= CAGE_TRIANGLES)
+        .unwrap_or(MAX_CAGE_LEVEL);
+    (1..=wanted)
+        .rev()
+        .find(|&l| triangles_at(corners, l) <= MAX_FIT_TRIANGLES)
+        .unwrap_or(1)
 }
 
 /// The positions the polygons use, in their order, and the corners renumbered over them.
@@ -131,5 +160,23 @@ fn split_quad(positions: &[Point3], q: [u32; 4]) -> [[u32; 3]; 2] {
         [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
     } else {
         [[q[0], q[1], q[3]], [q[1], q[2], q[3]]]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_level_reaches_the_target_within_the_fit() {
+        // The slab cage's 200 corners: 6 400 triangles at 3, 25 600 at 4.
+        assert_eq!(triangles_at(200, 3), 6_400);
+        assert_eq!(default_level(200), 4);
+        // A cage of 8 000 quads (32 000 corners): 256 000 triangles at 2 are more than the fit
+        // takes, 64 000 at 1 are not.
+        assert_eq!(default_level(32_000), 1);
+        // A tetrahedron's 12 corners: 12 · 4⁵ · 2 = 24 576 triangles at 6 (the most levels).
+        assert_eq!(default_level(12), 6);
+        assert_eq!(triangles_at(usize::MAX, 6), usize::MAX);
     }
 }

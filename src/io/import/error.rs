@@ -180,7 +180,7 @@ pub enum ImportError {
     )]
     CageOrientation { triangles: usize },
     #[error(
-        "refining the cage {level} times would make {triangles} triangles; the fit takes at most {max}, and at most {} levels",
+        "refining the cage {level} times would make {triangles} triangles; the fit takes at most {max}, and 1 to {} levels (--cage-level)",
         super::cage::MAX_CAGE_LEVEL
     )]
     CageTooFine {

@@ -142,18 +142,6 @@ pub struct Polygons {
     pub corners: Vec<u32>,
 }
 
-impl Polygons {
-    /// Each polygon's corners in turn (stopping where `corners` runs out).
-    pub fn iter(&self) -> impl Iterator<Item = &[u32]> {
-        let mut start = 0;
-        self.sides.iter().map_while(move |&s| {
-            let polygon = self.corners.get(start..start + s as usize)?;
-            start += s as usize;
-            Some(polygon)
-        })
-    }
-}
-
 /// A mesh ready to fit: one closed, connected, consistently oriented manifold of genus 0..=64.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ValidMesh {
