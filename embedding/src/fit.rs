@@ -71,6 +71,9 @@ pub struct Parameterization {
     /// Newton's solve of the map, over every reweighting round (`None` for the sphere, whose map is
     /// relaxed by sweeps alone).
     pub newton: Option<Convergence>,
+    /// The map's distortion where there is no cut disk to measure it on (a user's mesh, mapped
+    /// closed: each triangle in the frame its corners were solved in); `None` otherwise.
+    pub map_distortion: Option<Distortion>,
 }
 
 /// How far a map of the mesh onto the model is from conformal and from area-preserving, per
@@ -90,54 +93,37 @@ pub struct Distortion {
 }
 
 impl Parameterization {
-    /// The map's [`Distortion`] over the cut disk's triangles (`None` for the sphere, which has no
-    /// disk). `positions` are the mesh's; `geometry` the model's (the polygon's).
+    /// The map's [`Distortion`] over the cut disk's triangles, or for a user's mesh (no disk) over
+    /// its own (`None` for the sphere). `positions` are the mesh's; `geometry` the model's (the
+    /// polygon's).
     pub fn distortion(&self, positions: &[Point3], geometry: Geometry) -> Option<Distortion> {
-        let disk = self.disk.as_ref()?;
+        let Some(disk) = self.disk.as_ref() else {
+            return self.map_distortion;
+        };
         let hyperbolic = geometry == Geometry::Hyperbolic;
-        let mut triangles = Vec::with_capacity(disk.triangles.len());
-        for t in &disk.triangles {
-            let [a, b, c] = t.map(|v| positions[disk.original[v as usize] as usize]);
-            let z = t.map(|v| self.copies[v as usize]);
-            // The model triangle, flat to first order: in the Poincaré disk, moved so its first
-            // corner is at the origin, where lengths are twice Euclidean ones.
-            let w = if hyperbolic {
-                let to = |q: Complex64| 2.0 * (q - z[0]) / (Complex64::ONE - z[0].conj() * q);
-                [Complex64::ZERO, to(z[1]), to(z[2])]
-            } else {
-                [Complex64::ZERO, z[1] - z[0], z[2] - z[0]]
-            };
-            // The 3D triangle in its own plane: e1 along ab.
-            let (ab, ac) = (b - a, c - a);
-            let e1 = ab.normalize();
-            let normal = ab.cross(&ac);
-            let area3 = normal.norm() / 2.0;
-            let e2 = normal.normalize().cross(&e1);
-            // M maps (|ab|, 0) ↦ w1 and (ac·e1, ac·e2) ↦ w2.
-            let (p, q) = ((ab.norm(), 0.0), (ac.dot(&e1), ac.dot(&e2)));
-            let det = p.0 * q.1 - p.1 * q.0;
-            let m = [
-                [
-                    (w[1].re * q.1 - w[2].re * p.1) / det,
-                    (w[2].re * p.0 - w[1].re * q.0) / det,
-                ],
-                [
-                    (w[1].im * q.1 - w[2].im * p.1) / det,
-                    (w[2].im * p.0 - w[1].im * q.0) / det,
-                ],
-            ];
-            let jac = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-            // σ₁,₂ = (|conformal part| ± |anti-conformal part|): no cancellation near conformal.
-            let conformal = (m[0][0] + m[1][1]).hypot(m[1][0] - m[0][1]) / 2.0;
-            let anti = (m[0][0] - m[1][1]).hypot(m[1][0] + m[0][1]) / 2.0;
-            let (s1, s2) = (conformal + anti, (conformal - anti).abs());
-            triangles.push((area3, s1 / s2, jac));
-        }
+        let triangles: Vec<_> = disk
+            .triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|v| positions[disk.original[v as usize] as usize]);
+                triangle_distortion(p, t.map(|v| self.copies[v as usize]), hyperbolic)
+            })
+            .collect();
+        Distortion::of(&triangles)
+    }
+}
+
+impl Distortion {
+    /// The summary of each triangle's (3D area, σ₁/σ₂, model area over 3D area).
+    pub(crate) fn of(triangles: &[(f64, f64, f64)]) -> Option<Distortion> {
         let total3: f64 = triangles.iter().map(|t| t.0).sum();
         let total2: f64 = triangles.iter().map(|t| t.0 * t.2).sum();
+        if triangles.is_empty() || total3 <= 0.0 {
+            return None;
+        }
         let ratio = total2 / total3;
         let (mut angle_sum, mut angle_max, mut log_sum, mut log_max) = (0.0, 1.0f64, 0.0, 0.0f64);
-        for &(area, angle, jac) in &triangles {
+        for &(area, angle, jac) in triangles {
             let log = (jac / ratio).abs().ln().abs();
             let angle = if angle.is_finite() {
                 angle
@@ -156,6 +142,49 @@ impl Parameterization {
             area_max: log_max.exp(),
         })
     }
+}
+
+/// One triangle's (3D area, σ₁/σ₂, model area over 3D area) for corners `p` mapped to `z` in the
+/// model (Poincaré disk or plane).
+pub(crate) fn triangle_distortion(
+    p: [Point3; 3],
+    z: [Complex64; 3],
+    hyperbolic: bool,
+) -> (f64, f64, f64) {
+    let [a, b, c] = p;
+    // The model triangle, flat to first order: in the Poincaré disk, moved so its first corner is
+    // at the origin, where lengths are twice Euclidean ones.
+    let w = if hyperbolic {
+        let to = |q: Complex64| 2.0 * (q - z[0]) / (Complex64::ONE - z[0].conj() * q);
+        [Complex64::ZERO, to(z[1]), to(z[2])]
+    } else {
+        [Complex64::ZERO, z[1] - z[0], z[2] - z[0]]
+    };
+    // The 3D triangle in its own plane: e1 along ab.
+    let (ab, ac) = (b - a, c - a);
+    let e1 = ab.normalize();
+    let normal = ab.cross(&ac);
+    let area3 = normal.norm() / 2.0;
+    let e2 = normal.normalize().cross(&e1);
+    // M maps (|ab|, 0) ↦ w1 and (ac·e1, ac·e2) ↦ w2.
+    let (p, q) = ((ab.norm(), 0.0), (ac.dot(&e1), ac.dot(&e2)));
+    let det = p.0 * q.1 - p.1 * q.0;
+    let m = [
+        [
+            (w[1].re * q.1 - w[2].re * p.1) / det,
+            (w[2].re * p.0 - w[1].re * q.0) / det,
+        ],
+        [
+            (w[1].im * q.1 - w[2].im * p.1) / det,
+            (w[2].im * p.0 - w[1].im * q.0) / det,
+        ],
+    ];
+    let jac = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    // σ₁,₂ = (|conformal part| ± |anti-conformal part|): no cancellation near conformal.
+    let conformal = (m[0][0] + m[1][1]).hypot(m[1][0] - m[0][1]) / 2.0;
+    let anti = (m[0][0] - m[1][1]).hypot(m[1][0] + m[0][1]) / 2.0;
+    let (s1, s2) = (conformal + anti, (conformal - anti).abs());
+    (area3, s1 / s2, jac)
 }
 
 /// The map is solved until no vertex is further than this from its neighbours' weighted average
@@ -574,6 +603,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
         folded: 0,
         sweeps: 0,
         newton: None,
+        map_distortion: None,
     }
 }
 
@@ -632,6 +662,7 @@ fn flatten(
         folded,
         sweeps: solved.sweeps,
         newton: Some(solved),
+        map_distortion: None,
     })
 }
 
@@ -888,6 +919,19 @@ impl Lifts {
     /// A triangle's corners in its frame.
     fn corner_positions(&self, t: &[(u32, Lft); 3]) -> [Complex64; 3] {
         t.map(|(v, g)| g.apply(self.home[v as usize]))
+    }
+
+    /// The map's [`Distortion`] over every triangle, each in its corners' frame.
+    pub(crate) fn distortion(&self, positions: &[Point3], hyperbolic: bool) -> Option<Distortion> {
+        let triangles: Vec<_> = self
+            .corners
+            .iter()
+            .map(|t| {
+                let p = t.map(|(v, _)| positions[v as usize]);
+                triangle_distortion(p, self.corner_positions(t), hyperbolic)
+            })
+            .collect();
+        Distortion::of(&triangles)
     }
 
     /// Triangles whose lifted corners are not counter-clockwise (hyperbolic or Euclidean area ≤ 0):

@@ -34,8 +34,8 @@ use mesh::schema::{self, Letter, LoopSystem};
 use num_complex::Complex64;
 
 use crate::fit::{
-    FitSettings, FitStage, Lifts, Parameterization, RELAX_TOLERANCE, deepest, diagonal, fit,
-    stereographic_points, vertex_areas,
+    Distortion, FitSettings, FitStage, Lifts, Parameterization, RELAX_TOLERANCE, deepest, diagonal,
+    fit, stereographic_points, vertex_areas,
 };
 use crate::harmonic::Convergence;
 use crate::sphere_map::{EXTRA_ROUNDS, sphere_map};
@@ -152,6 +152,7 @@ pub fn mesh_model(
             folded: mapped.folded,
             sweeps: mapped.sweeps,
             newton: mapped.solved,
+            map_distortion: mapped.distortion,
         },
         loops: mapped.loops,
         rms_residual: (sum / positions.len() as f64).sqrt(),
@@ -169,6 +170,8 @@ struct Mapped {
     sweeps: usize,
     /// Newton's solve of the polygon's map (none for the sphere's).
     solved: Option<Convergence>,
+    /// The polygon map's distortion (none for the sphere's).
+    distortion: Option<Distortion>,
     loops: LoopReport,
 }
 
@@ -200,6 +203,7 @@ fn map_to_sphere(
         folded: map.folded,
         sweeps: map.sweeps,
         solved: None,
+        distortion: None,
         loops: LoopReport {
             base: 0,
             paths: Vec::new(),
@@ -242,6 +246,7 @@ fn map_to_polygon(
     }
     let sweeps = solved.sweeps;
     let folded = lifts.folded_triangles(hyperbolic);
+    let distortion = lifts.distortion(positions, hyperbolic);
     let points = lifts
         .home
         .iter()
@@ -262,6 +267,7 @@ fn map_to_polygon(
         folded,
         sweeps,
         solved: Some(solved),
+        distortion,
         loops,
     })
 }

@@ -3,10 +3,10 @@
 //! differ from case to case).
 
 use charts::{Lft, Polygon};
-use embedding::SplineSettings;
 use embedding::fit::FitSettings;
 use embedding::holed::HoledMesh;
 use embedding::mesh_fit::{canonical_element, mesh_model, word_element};
+use embedding::{Point3, SplineSettings};
 use mesh::HalfEdgeMesh;
 use mesh::schema::{
     Letter, canonicalize, cyclically_equal, dehn_reduce, edge_words, inverse, loop_system,
@@ -159,6 +159,41 @@ fn shuffled_plates_fit() {
         );
         assert_eq!(fit.parameterization.points.len(), positions.len());
         assert!(fit.loops.closure_error < 1e-8);
+        // The closed map's distortion is measured (no cut disk): plausible, and blind to the
+        // mesh's scale (the map and the relative areas do not change when the mesh grows).
+        let geometry = charts::Atlas::new(genus).unwrap().geometry();
+        let d = fit
+            .parameterization
+            .distortion(&positions, geometry)
+            .unwrap();
+        assert!(
+            1.0 <= d.angle_mean && d.angle_mean <= d.angle_max && d.angle_max < 50.0,
+            "genus {genus}: {d:?}"
+        );
+        assert!(
+            1.0 <= d.area_mean && d.area_mean <= d.area_max && d.area_max < 50.0,
+            "genus {genus}: {d:?}"
+        );
+        if genus == 2 {
+            let grown: Vec<Point3> = positions.iter().map(|p| p * 10.0).collect();
+            let again = mesh_model(
+                &grown,
+                &triangles,
+                SplineSettings::default(),
+                FitSettings::default(),
+                &|_| {},
+            )
+            .unwrap();
+            let e = again.parameterization.distortion(&grown, geometry).unwrap();
+            for (a, b) in [
+                (d.angle_mean, e.angle_mean),
+                (d.angle_max, e.angle_max),
+                (d.area_mean, e.area_mean),
+                (d.area_max, e.area_max),
+            ] {
+                assert!((a - b).abs() <= 1e-6 * a, "{d:?} vs {e:?}");
+            }
+        }
     }
 }
 

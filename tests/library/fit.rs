@@ -354,6 +354,7 @@ fn distortion_measures_known_maps() {
         folded: 0,
         sweeps: 0,
         newton: None,
+        map_distortion: None,
     };
     for (a, b, c, d) in [
         (2.0, 0.0, 0.0, 1.0),
