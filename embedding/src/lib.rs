@@ -83,10 +83,11 @@ pub enum EmbeddingError {
     #[error("the {0} brush has no dab: it follows the pointer")]
     NoDab(&'static str),
     #[error(
-        "genus {genus} at mesh resolution {resolution} makes {}{triangles} input triangles, which would take about {:.1} GB to fit ({} bytes a triangle, measured); the fit takes at most {max} triangles: lower the resolution",
+        "genus {genus} at mesh resolution {resolution} makes {}{triangles} input triangles, which would take about {:.1} GB to fit ({} bytes a triangle, measured); the fit takes at most {max} triangles: {}",
         if *.at_least { "more than " } else { "" },
         *.triangles as f64 * fit::FIT_BYTES_PER_TRIANGLE as f64 / 1e9,
-        fit::FIT_BYTES_PER_TRIANGLE
+        fit::FIT_BYTES_PER_TRIANGLE,
+        if *.resolution > 8 { "lower the resolution" } else { "even the lowest resolution (8) is too fine for this genus" }
     )]
     FitTooLarge {
         genus: u32,

@@ -226,7 +226,7 @@ fn fits_beyond_the_memory_cap_are_refused_before_fitting() {
     );
     let text = err.to_string();
     assert!(
-        text.contains("GB to fit") && text.contains("lower the resolution"),
+        text.contains("GB to fit") && text.contains("even the lowest resolution (8) is too fine"),
         "{text}"
     );
     // The largest genus-16 mesh at resolution 32 is within the cap: it is meshed, not refused.
