@@ -95,7 +95,7 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 /// The spline and the fit's weight, as `new` and `fit` take them.
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct FitArgs {
-    /// Control points per side of each chart's grid [default: 32 for new and fit --cage, 20 for fit: a user's
+    /// Control points per side of each chart's grid [default: 32 for new (40 from genus 21) and fit --cage, 20 for fit: a user's
     /// mesh is often coarser than the plates, and a grid finer than the data overfits it]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=64))]
     grid: Option<u64>,

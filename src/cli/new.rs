@@ -85,7 +85,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         quiet,
     } = args;
-    let (settings, fit) = spline.settings(SplineSettings::default().grid);
+    let (settings, fit) = spline.settings(embedding::fit::default_grid(genus));
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;

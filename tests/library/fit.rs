@@ -410,6 +410,22 @@ fn a_system_the_sparse_qr_cannot_factor_is_solved_by_the_normal_equations() {
     );
 }
 
+/// The grid grows where genus 24 needs it and nowhere below (see `default_grid`'s measurements).
+#[test]
+fn the_default_grid_is_32_up_to_genus_20_and_40_above() {
+    use embedding::fit::default_grid;
+    for genus in 0..=20 {
+        assert_eq!(
+            default_grid(genus),
+            SplineSettings::default().grid,
+            "genus {genus}"
+        );
+    }
+    for genus in [21, 24, 32, 64] {
+        assert_eq!(default_grid(genus), 40, "genus {genus}");
+    }
+}
+
 /// Without a chosen resolution, high genus gets the finest mesh the fit takes, not a refusal.
 #[test]
 fn the_default_resolution_keeps_high_genus_within_the_fit() {
