@@ -725,12 +725,7 @@ fn export_and_screenshot_through_the_file_prompt() {
     // background.
     let mesh_path = dir.path().join("surface.ply");
     harness.key_press_modifiers(Modifiers::COMMAND, Key::E);
-    harness.run();
-    harness
-        .get_by_label("File:")
-        .set_text_value_accesskit(mesh_path.to_str().unwrap());
-    harness.run();
-    harness.get_by_label("Export").click();
+    answer_file_prompt(&mut harness, &mesh_path, "Export");
     harness.run_steps(2);
     harness.state_mut().wait_for_job();
     harness.run();
@@ -741,15 +736,24 @@ fn export_and_screenshot_through_the_file_prompt() {
     // F12: a screenshot of the viewport.
     let png_path = dir.path().join("view.png");
     harness.key_press(Key::F12);
-    harness.run();
-    harness
-        .get_by_label("File:")
-        .set_text_value_accesskit(png_path.to_str().unwrap());
-    harness.run();
-    harness.get_by_label("Save").click();
+    answer_file_prompt(&mut harness, &png_path, "Save");
     harness.run();
     let png = std::fs::read(&png_path).expect("the screenshot was written");
     assert_eq!(&png[1..4], b"PNG");
+}
+
+/// Answers the in-window file prompt that the last key opened: `path`, then `button`.
+fn answer_file_prompt(
+    harness: &mut Harness<'static, EditorApp>,
+    path: &std::path::Path,
+    button: &str,
+) {
+    harness.run();
+    harness
+        .get_by_label("File:")
+        .set_text_value_accesskit(path.to_str().unwrap());
+    harness.run();
+    harness.get_by_label(button).click();
 }
 
 /// The vertex and face counts of a PLY header.
@@ -984,12 +988,7 @@ fn an_imported_mesh_becomes_an_untitled_model() {
     let mut harness = harness();
     let import = |harness: &mut Harness<'static, EditorApp>, path: &std::path::Path| {
         harness.key_press_modifiers(Modifiers::COMMAND, Key::I);
-        harness.run();
-        harness
-            .get_by_label("File:")
-            .set_text_value_accesskit(path.to_str().unwrap());
-        harness.run();
-        harness.get_by_label("Import").click();
+        answer_file_prompt(harness, path, "Import");
         harness.run_steps(2);
         harness.state_mut().wait_for_job();
         harness.run();

@@ -15,6 +15,15 @@ use embedding::quality::{
 use embedding::{Layout, Model, Point3, SplineSettings, Stencil, Surface, Vector3};
 use proptest::prelude::*;
 
+/// The initial fit of `genus` on an 8 × 8 grid to a resolution-16 mesh: quick, and smooth enough.
+fn coarse_fit(genus: u32) -> embedding::fit::InitialFit {
+    let settings = SplineSettings {
+        grid: 8,
+        ..SplineSettings::default()
+    };
+    initial_model(genus, 16, settings, FitSettings::default()).unwrap()
+}
+
 fn surface(genus: u32, control: impl FnOnce(&Layout) -> Vec<Point3>) -> Surface {
     let atlas = Arc::new(Atlas::new(genus).unwrap());
     let settings = SplineSettings::default();
@@ -176,16 +185,12 @@ fn a_flat_mesh_has_no_curvature_and_a_rough_one_reads_more_curved() {
 
 #[test]
 fn a_fitted_surface_does_not_cross_itself_and_one_turned_inside_out_does() {
-    let settings = SplineSettings {
-        grid: 8,
-        ..SplineSettings::default()
-    };
-    let fit = initial_model(0, 16, settings, FitSettings::default()).unwrap();
+    let fit = coarse_fit(0);
     assert_eq!(tessellation_crossings(&fit.surface, 12).unwrap(), 0);
     // One cap's control points mirrored through the equator's plane: that patch now pokes through
     // the other half of the sphere where the two blend.
     let layout = fit.surface.layout();
-    let grid = settings.grid;
+    let grid = fit.surface.settings().grid;
     let mut control = fit.surface.control_points().to_vec();
     for j in 0..grid {
         for i in 0..grid {
@@ -199,11 +204,7 @@ fn a_fitted_surface_does_not_cross_itself_and_one_turned_inside_out_does() {
 
 #[test]
 fn a_fitted_sphere_has_curvature_near_one_over_its_radius() {
-    let settings = SplineSettings {
-        grid: 8,
-        ..SplineSettings::default()
-    };
-    let fit = initial_model(0, 16, settings, FitSettings::default()).unwrap();
+    let fit = coarse_fit(0);
     let s = &fit.surface;
     let points = sample_points(s, 12).unwrap();
     let layout = s.layout();
@@ -229,11 +230,7 @@ fn a_fitted_sphere_has_curvature_near_one_over_its_radius() {
 
 #[test]
 fn normal_deviation_falls_as_the_mesh_refines_and_rises_when_it_is_rough() {
-    let settings = SplineSettings {
-        grid: 8,
-        ..SplineSettings::default()
-    };
-    let fit = initial_model(2, 16, settings, FitSettings::default()).unwrap();
+    let fit = coarse_fit(2);
     let s = &fit.surface;
     let mesh_at = |t: u32| {
         let tess = s.atlas().tessellate(t, t).unwrap();

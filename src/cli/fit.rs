@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context as _;
-use embedding::fit::{FitStage, MAX_FIT_TRIANGLES};
+use embedding::fit::FitStage;
 use embedding::mesh_fit::{MESH_FIT_GRID, MeshFit, mesh_model};
 use ntori::io::import::{self, ValidMesh, cage};
 use serde::Serialize;
@@ -88,7 +88,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
         (valid, None)
     };
-    refuse_unfittable(&args.mesh, &valid)?;
+    import::check_fittable(&valid)
+        .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
     // A cage's limit mesh is as dense as `new`'s plates, so it takes `new`'s grid: the genus-2 slab
     // cage at 20 / 32 fits with patches 0.84% / 0.42% apart, normals 4.5° / 1.6° off its limit
     // normals at the 90th percentile.
@@ -185,18 +186,6 @@ struct CageReport {
     /// uses (left out).
     flipped: bool,
     unused_vertices: usize,
-}
-
-/// Meshes beyond the fit's size are refused before any work.
-fn refuse_unfittable(path: &Path, valid: &ValidMesh) -> anyhow::Result<()> {
-    if valid.triangles.len() > MAX_FIT_TRIANGLES {
-        anyhow::bail!(
-            "cannot fit {}: it has {} triangles, and the fit takes at most {MAX_FIT_TRIANGLES} (decimate it first)",
-            path.display(),
-            valid.triangles.len()
-        );
-    }
-    Ok(())
 }
 
 fn as_fitted<'a>(

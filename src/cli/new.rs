@@ -326,9 +326,9 @@ impl ShapeVerdict {
 pub enum NormalReference {
     /// The intended shape's exact normals (`new`'s plates, sphere and torus).
     Intended,
-    /// The input mesh's area-weighted vertex normals (`fit`'s meshes), which carry the mesh's own
-    /// faceting: at resolution 32 a plate's mesh normals are 4° to 5° off its shape's at the 90th
-    /// percentile.
+    /// The input mesh's vertex normals (`fit`'s meshes; `quality::vertex_normals`), which carry
+    /// the mesh's own faceting: at resolution 32 a plate's mesh normals are 4° to 5° off its
+    /// shape's at the 90th percentile.
     Mesh,
 }
 

@@ -6,9 +6,7 @@ use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
-use embedding::fit::{
-    FitSettings, MAX_FIT_TRIANGLES, default_resolution, initial_model, vertex_areas,
-};
+use embedding::fit::{FitSettings, default_resolution, initial_model, vertex_areas};
 use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
 use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
@@ -125,14 +123,8 @@ impl Jobs {
         self.spawn(format!("importing {name}"), move || {
             let read = import::read_mesh(&path).map_err(|e| JobError::Import(e.to_string()))?;
             let valid = import::validate(read, false)
+                .and_then(|valid| import::check_fittable(&valid).map(|()| valid))
                 .map_err(|e| JobError::Import(format!("{}: {e}", path.display())))?;
-            if valid.triangles.len() > MAX_FIT_TRIANGLES {
-                return Err(JobError::Import(format!(
-                    "{}: it has {} triangles, and the fit takes at most {MAX_FIT_TRIANGLES} (decimate it first)",
-                    path.display(),
-                    valid.triangles.len()
-                )));
-            }
             let settings = SplineSettings {
                 grid: MESH_FIT_GRID,
                 ..SplineSettings::default()

@@ -3,7 +3,7 @@
 
 use predicates::prelude::*;
 
-use crate::common::{asset, ntori};
+use crate::common::{asset, ntori, ntori_json};
 
 #[test]
 fn fit_writes_a_model_of_the_mesh_genus_that_passes_its_checks() {
@@ -113,6 +113,17 @@ fn opensubdiv() -> bool {
     anchors::available()
 }
 
+/// `ntori fit --cage --json -q [EXTRA…] -o OUT MESH`, which must succeed, and its report.
+fn fit_cage(mesh: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> serde_json::Value {
+    let mut args: Vec<std::ffi::OsString> = ["fit", "--cage", "--json", "-q"]
+        .iter()
+        .chain(extra)
+        .map(Into::into)
+        .collect();
+    args.extend(["-o".into(), out.into(), mesh.into()]);
+    ntori_json(&args)
+}
+
 fn write_obj(path: &std::path::Path, positions: &[[f32; 3]], faces: &[Vec<u32>]) {
     let mut text = String::new();
     for p in positions {
@@ -136,16 +147,7 @@ fn a_subdivision_cage_fits_its_limit_surface() {
     let path = dir.path().join("slab.obj");
     let faces: Vec<Vec<u32>> = cage.faces.iter().map(|f| f.to_vec()).collect();
     write_obj(&path, &cage.positions, &faces);
-    let out = ntori()
-        .args(["fit", "--cage", "--json", "-q", "-o"])
-        .arg(dir.path().join("slab.json"))
-        .arg(&path)
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let report = fit_cage(&path, &dir.path().join("slab.json"), &[]);
     let (input, fit) = (&report["input"], &report["fit"]);
     assert_eq!(fit["genus"], 2, "{report}");
     assert_eq!(fit["passed"], true, "{report}");
@@ -206,16 +208,8 @@ fn a_cage_with_pentagons_is_refined_and_fitted() {
     ];
     let path = dir.path().join("house.obj");
     write_obj(&path, &positions, &faces);
-    let out = ntori()
-        .args(["fit", "--cage", "--cage-level", "4", "--json", "-q", "-o"])
-        .arg(dir.path().join("house.json"))
-        .arg(&path)
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let level = ["--cage-level", "4"];
+    let report = fit_cage(&path, &dir.path().join("house.json"), &level);
     assert_eq!(report["fit"]["genus"], 0, "{report}");
     assert_eq!(report["fit"]["passed"], true, "{report}");
     assert_eq!(report["input"]["cage"]["non_quads"], 2, "{report}");
@@ -235,16 +229,7 @@ fn a_cage_with_pentagons_is_refined_and_fitted() {
         .collect();
     let inside_out = dir.path().join("inside-out.obj");
     write_obj(&inside_out, &stray, &reversed);
-    let out = ntori()
-        .args(["fit", "--cage", "--cage-level", "4", "--json", "-q", "-o"])
-        .arg(dir.path().join("inside-out.json"))
-        .arg(&inside_out)
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let report = fit_cage(&inside_out, &dir.path().join("inside-out.json"), &level);
     assert_eq!(report["input"]["flipped"], true, "{report}");
     assert_eq!(report["input"]["cage"]["flipped"], true, "{report}");
     assert_eq!(report["input"]["cage"]["unused_vertices"], 1, "{report}");

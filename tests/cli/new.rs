@@ -2,7 +2,7 @@
 
 use predicates::prelude::*;
 
-use crate::common::ntori;
+use crate::common::{ntori, ntori_json};
 
 #[test]
 fn new_writes_a_valid_model_and_passes_its_checks() {
@@ -98,15 +98,11 @@ fn a_rippled_fit_fails_its_shape_checks_though_its_residual_passes() {
     assert_eq!(report["passed"], false, "{report}");
     assert!(!path.exists(), "a failed model was written");
     // The default grid on a finer mesh fits the same genus well: every shape check passes.
-    let out = ntori()
-        .args(["new", "--genus", "2", "--resolution", "24", "--json", "-o"])
-        .arg(&path)
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let mut args: Vec<std::ffi::OsString> = ["new", "--genus", "2", "--resolution", "24", "--json"]
+        .map(Into::into)
+        .to_vec();
+    args.extend(["-o".into(), path.clone().into()]);
+    let report = ntori_json(&args);
     assert_eq!(
         report["shape_verdict"],
         serde_json::json!({"disagreement": true, "curvature": true, "normals": true, "embedded": true}),

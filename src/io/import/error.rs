@@ -174,6 +174,10 @@ pub enum ImportError {
     #[error("the mesh has more than {max} triangles{at}, the most ntori reads")]
     TooManyTriangles { at: Location, max: usize },
 
+    // ----- the fit's size
+    #[error("it has {triangles} triangles, and the fit takes at most {max} (decimate it first)")]
+    TooLargeToFit { triangles: usize, max: usize },
+
     // ----- subdivision cages (`ntori fit --cage`)
     #[error(
         "a cage is refined as its faces are given, so they must agree in orientation, and {triangles} of its triangles (its faces cut) turn the other way"

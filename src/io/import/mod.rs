@@ -161,6 +161,19 @@ pub struct ValidMesh {
     pub flipped: bool,
 }
 
+/// Refuses, before any work, a valid mesh with more triangles than the fit takes
+/// ([`embedding::fit::MAX_FIT_TRIANGLES`]): `ntori fit` and the editor's import alike.
+pub fn check_fittable(valid: &ValidMesh) -> Result<(), ImportError> {
+    let max = embedding::fit::MAX_FIT_TRIANGLES;
+    if valid.triangles.len() > max {
+        return Err(ImportError::TooLargeToFit {
+            triangles: valid.triangles.len(),
+            max,
+        });
+    }
+    Ok(())
+}
+
 /// Reads a mesh file, its format from its extension. File errors and format errors name the file.
 pub fn read_mesh(path: &Path) -> Result<ImportedMesh, ImportError> {
     // What the path is comes first: a missing file, a directory or a FIFO is named as such, whatever
