@@ -1091,7 +1091,7 @@ pub fn klein_to_poincare(k: Complex64) -> Complex64 {
 // ------------------------------------------------------------------------------------------ fit
 
 /// Least-squares control points: Σ_i w_i |S(p_i) − P_i|² + smoothness, solved at once for every
-/// chart by a sparse QR factorisation (the three coordinates share it). `weights` are per-point
+/// chart by one sparse factorisation (the three coordinates share it; see [`least_squares`]). `weights` are per-point
 /// weights (e.g. vertex areas; normalised here to mean 1).
 pub fn fit(
     layout: &Layout,
@@ -1169,27 +1169,7 @@ pub fn fit(
             rhs[(points.len() + k, d)] = scale * t[d];
         }
     }
-    let x = match least_squares(rows, cols, &triplets, &rhs)? {
-        Some(x) => x,
-        None => {
-            // faer's supernodal QR panics on some wide systems (measured: genus 1 or 2 with a
-            // 48- or 64-point grid on a resolution-8 or -16 mesh). A row ε·e_c per column makes
-            // the system structurally full rank and the factorization goes through; ε = 1e-6
-            // against data rows of mean weight 1 moves the solution by about ε² of its size.
-            // Only systems that failed take this path, so every other fit is unchanged.
-            const EPSILON: f64 = 1e-6;
-            triplets.extend((0..cols).map(|c| Triplet::new(rows + c, c, EPSILON)));
-            let mut padded = Mat::<f64>::zeros(rows + cols, 3);
-            padded.as_mut().subrows_mut(0, rows).copy_from(&rhs);
-            match least_squares(rows + cols, cols, &triplets, &padded)? {
-                Some(x) => x,
-                // Measured: the editor's refit of a genus-2 model to grid 34 (309 738 rows) fails
-                // both ways. The normal equations square the condition number, but the
-                // smoothness rows keep it far from f64's limit, and sparse LU does not fail here.
-                None => normal_equations(rows + cols, cols, &triplets, &padded)?,
-            }
-        }
-    };
+    let x = least_squares(rows, cols, &triplets, &rhs)?;
     let control: Vec<Point3> = (0..cols)
         .map(|c| Point3::new(x[(c, 0)], x[(c, 1)], x[(c, 2)]))
         .collect();
@@ -1204,35 +1184,27 @@ pub fn fit(
     Ok(control)
 }
 
-/// The least-squares solution of A x = rhs (A given by triplets) through faer's sparse QR, or `None`
-/// where faer panicked (an assertion inside its supernodal factorization; see [`fit`]).
+/// The least-squares solution of A x = rhs (A given by triplets, three right-hand sides): the
+/// corrected seminormal equations (Björck 1987). The normal equations AᵀA x = Aᵀ rhs are factored
+/// by sparse Cholesky, and one step of iterative refinement on the residual of the system itself,
+/// x += (AᵀA)⁻¹ Aᵀ(rhs − A x), takes back the accuracy the normal equations lose to the squared
+/// condition number (forward stable for cond(A) up to about 1/√ε; the smoothness rows keep the
+/// fit's systems there). Measured against faer's sparse QR, which this replaces: the default
+/// genus-2 plate's control points agree to 3e-11 (diagonal 7.7) and the solve takes 0.2 s instead of
+/// 2.1 s; QR also panicked inside its supernodal factorization on some wide systems (a grid far
+/// finer than the data).
+///
+/// Where no row reaches some control point, or the data leave some combination undetermined, AᵀA
+/// is singular and its Cholesky factorization fails; then the system is solved with a row ε·e_c per
+/// column (AᵀA + ε² I), which picks the smallest such combination and moves a determined solution by
+/// about ε² of its size.
 pub(crate) fn least_squares(
     rows: usize,
     cols: usize,
     triplets: &[Triplet<usize, usize, f64>],
     rhs: &Mat<f64>,
-) -> Result<Option<Mat<f64>>, EmbeddingError> {
-    let a = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, triplets)
-        .map_err(|e| EmbeddingError::Parameterization(format!("{e:?}")))?;
-    // The closure owns nothing that outlives a panic: `a` is dropped with it, `rhs` only read.
-    let solved = caught_quietly(|| a.sp_qr().map(|qr| qr.solve_lstsq(rhs)));
-    match solved {
-        Ok(Ok(x)) => Ok(Some(x)),
-        Ok(Err(e)) => Err(EmbeddingError::Parameterization(format!(
-            "the fit's QR failed: {e:?}"
-        ))),
-        Err(_) => Ok(None),
-    }
-}
-
-/// The least-squares solution of A x = rhs through the normal equations AᵀA x = Aᵀ rhs, by sparse
-/// LU: the last resort where faer's sparse QR failed (see [`fit`]).
-fn normal_equations(
-    rows: usize,
-    cols: usize,
-    triplets: &[Triplet<usize, usize, f64>],
-    rhs: &Mat<f64>,
 ) -> Result<Mat<f64>, EmbeddingError> {
+    const EPSILON: f64 = 1e-6;
     let failed = |what: String| {
         EmbeddingError::Parameterization(format!(
             "the sparse least-squares solver failed on {rows} rows and {cols} control points \
@@ -1241,11 +1213,10 @@ fn normal_equations(
     };
     let a = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, triplets)
         .map_err(|e| failed(format!("{e:?}")))?;
-    let transposed: Vec<_> = triplets
-        .iter()
-        .map(|t| Triplet::new(t.col, t.row, t.val))
-        .collect();
-    let at = SparseColMat::<usize, f64>::try_new_from_triplets(cols, rows, &transposed)
+    let at = a
+        .as_ref()
+        .transpose()
+        .to_col_major()
         .map_err(|e| failed(format!("{e:?}")))?;
     let gram = faer::sparse::linalg::matmul::sparse_sparse_matmul(
         at.as_ref(),
@@ -1254,34 +1225,27 @@ fn normal_equations(
         faer::Par::Seq,
     )
     .map_err(|e| failed(format!("{e:?}")))?;
-    let projected = at.as_ref() * rhs.as_ref();
-    let lu = gram.sp_lu().map_err(|e| failed(format!("{e:?}")))?;
-    Ok(lu.solve(&projected))
-}
-
-thread_local! {
-    /// Set while [`caught_quietly`] runs its closure on this thread.
-    static CATCHING: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Runs `f`, turning a panic into `Err` without the panic hook's message on stderr: the caller
-/// handles the failure (here: retries, then a typed error), so "thread 'main' panicked" would only
-/// alarm. The hook is wrapped once; panics on other threads, or outside `f`, reach the hook that
-/// was installed before.
-fn caught_quietly<R>(f: impl FnOnce() -> R) -> std::thread::Result<R> {
-    static WRAP: std::sync::Once = std::sync::Once::new();
-    WRAP.call_once(|| {
-        let previous = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !CATCHING.with(std::cell::Cell::get) {
-                previous(info);
-            }
-        }));
-    });
-    CATCHING.with(|c| c.set(true));
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
-    CATCHING.with(|c| c.set(false));
-    result
+    let (factor, ridge) = match gram.sp_cholesky(faer::Side::Lower) {
+        Ok(factor) => (factor, 0.0),
+        Err(_) => {
+            let ridge = EPSILON * EPSILON;
+            let diagonal: Vec<_> = (0..cols).map(|c| Triplet::new(c, c, ridge)).collect();
+            let shift = SparseColMat::<usize, f64>::try_new_from_triplets(cols, cols, &diagonal)
+                .map_err(|e| failed(format!("{e:?}")))?;
+            let factor = (gram.as_ref() + shift.as_ref())
+                .sp_cholesky(faer::Side::Lower)
+                .map_err(|e| failed(format!("{e:?}")))?;
+            (factor, ridge)
+        }
+    };
+    // The gradient of ½|A x − rhs|² + ½ ridge |x|², negated: what the refinement step solves for.
+    let descent = |x: &Mat<f64>| -> Mat<f64> {
+        let residual = rhs - a.as_ref() * x.as_ref();
+        at.as_ref() * residual.as_ref() - x * faer::Scale(ridge)
+    };
+    let mut x = factor.solve(at.as_ref() * rhs.as_ref());
+    x += factor.solve(descent(&x));
+    Ok(x)
 }
 
 /// Second differences of every chart's control grid: along u, along v, and the mixed difference

@@ -58,36 +58,69 @@ pub fn surface_integrals(
     control: &[Point3],
     cells_per_knot: usize,
 ) -> SurfaceIntegrals {
+    use rayon::prelude::*;
     let settings = layout.settings();
     let cells = (settings.grid - settings.degree) * cells_per_knot.max(1);
     let h = 1.0 / cells as f64;
-    let mut sums = SurfaceIntegrals::default();
-    for chart in layout.atlas().charts() {
-        for (y, wy) in nodes(cells, h) {
+    let rows: Vec<(&charts::Chart, f64, f64)> = layout
+        .atlas()
+        .charts()
+        .iter()
+        .flat_map(|chart| nodes(cells, h).map(move |(y, wy)| (chart, y, wy)))
+        .collect();
+    // One row of Gauss points per task, summed in order afterwards: all cores, and the same sums
+    // whatever the number of threads.
+    let row_sums: Vec<SurfaceIntegrals> = rows
+        .par_iter()
+        .map(|&(chart, y, wy)| {
+            let mut sums = SurfaceIntegrals::default();
             for (x, wx) in nodes(cells, h) {
                 let w = Complex64::new(x, y);
                 if !chart.domain().contains(w) {
                     continue;
                 }
                 let p = ChartPoint::new(chart.id(), w);
-                let own = layout
-                    .blends(p)
-                    .into_iter()
-                    .find(|b| b.0 == chart.id())
-                    .map_or(0.0, |b| b.1);
+                let reps = layout.atlas().locate_with_transitions(p);
+                let own = normalised_blend(layout, chart, &reps);
                 if own == 0.0 {
                     continue;
                 }
-                let s = layout.eval(control, p);
+                let s = layout.eval_located(control, p, &reps);
                 let da = s.area_element() * wx * wy * own;
                 let k = s.gaussian_curvature();
                 sums.gaussian_curvature += k * da;
                 sums.absolute_curvature += k.abs() * da;
                 sums.area += da;
             }
-        }
-    }
-    sums
+            sums
+        })
+        .collect();
+    row_sums
+        .iter()
+        .fold(SurfaceIntegrals::default(), |a, b| SurfaceIntegrals {
+            gaussian_curvature: a.gaussian_curvature + b.gaussian_curvature,
+            absolute_curvature: a.absolute_curvature + b.absolute_curvature,
+            area: a.area + b.area,
+        })
+}
+
+/// The normalised blend b̂ of `chart` at a point whose representatives are `reps` (which include
+/// the point itself in `chart`).
+fn normalised_blend(
+    layout: &Layout,
+    chart: &charts::Chart,
+    reps: &[(ChartPoint, charts::Lft)],
+) -> f64 {
+    let raw = |rep: &ChartPoint| {
+        layout.raw_blend_value(
+            layout.atlas().charts()[rep.chart.index()].domain(),
+            rep.coords,
+        )
+    };
+    let total: f64 = reps.iter().map(|(r, _)| raw(r)).sum();
+    reps.iter()
+        .find(|(r, _)| r.chart == chart.id())
+        .map_or(0.0, |(r, _)| raw(r) / total)
 }
 
 /// Quadrature points and weights along [−½, ½] in `cells` cells of width `h`.

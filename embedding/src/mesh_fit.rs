@@ -283,19 +283,21 @@ struct Marked {
 /// The marking (which loop becomes which side of the polygon) decides the map: the harmonic map of
 /// a marking twisted round a handle squeezes that handle. Markings from a few well-spread base
 /// vertices (farthest-point samples along the mesh) are relaxed for [`SCREEN_SWEEPS`] sweeps each,
-/// and the one whose map stretches the surface most evenly is kept.
+/// and the one whose map stretches the surface most evenly is kept. The loop systems are found one
+/// after another (each base is the vertex farthest from the bases before it); the candidates'
+/// maps, which are most of the work, are made and scored on all cores, and the choice does not
+/// depend on the number of threads (ties go to the earlier candidate).
 fn best_marking(
     he: &HalfEdgeMesh,
     positions: &[Point3],
     triangles: &[[u32; 3]],
     areas: &[f64],
     polygon: &Polygon,
-    length: &impl Fn(u32) -> f64,
+    length: &(impl Fn(u32) -> f64 + Sync),
 ) -> Result<Marked, EmbeddingError> {
+    use rayon::prelude::*;
     let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
-    let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
-    let genus = polygon.genus() as usize;
-    let mut best: Option<(f64, Marked)> = None;
+    let mut systems = Vec::with_capacity(BASE_CANDIDATES);
     let mut nearest = vec![f64::INFINITY; he.vertex_count()];
     let mut base = 0u32;
     for _ in 0..BASE_CANDIDATES.min(he.vertex_count()) {
@@ -306,33 +308,59 @@ fn best_marking(
         base = (0..nearest.len())
             .max_by(|&a, &b| nearest[a].total_cmp(&nearest[b]))
             .unwrap_or(0) as u32;
-        let canonical =
-            schema::canonicalize(&system.relation, system.generators.len()).map_err(fail)?;
-        let words: Vec<schema::Word> = canonical
-            .originals
-            .iter()
-            .map(|w| schema::dehn_reduce(w, genus))
-            .collect();
-        let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
-        let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
-        lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
-        let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
-        tracing::debug!(
-            base = system.base,
-            score,
-            "marking screened (area-weighted mean of squared log stretch)"
-        );
-        if best.as_ref().is_none_or(|(s, _)| score < *s) {
-            let marked = Marked {
-                system,
-                words,
-                closure_error,
-                lifts,
-            };
-            best = Some((score, marked));
-        }
+        systems.push(system);
     }
-    Ok(best.expect("at least one candidate").1)
+    let screened = systems
+        .into_par_iter()
+        .enumerate()
+        .map(|(index, system)| {
+            let (score, marked) = screen(he, positions, triangles, areas, polygon, system)?;
+            Ok((score, index, marked))
+        })
+        .collect::<Result<Vec<_>, EmbeddingError>>()?;
+    screened
+        .into_iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+        .map(|(_, _, marked)| marked)
+        .ok_or_else(|| EmbeddingError::Parameterization("the mesh has no vertices".into()))
+}
+
+/// One candidate marking's map, relaxed for [`SCREEN_SWEEPS`] sweeps, and its score: how unevenly
+/// it stretches the surface (lower is better).
+fn screen(
+    he: &HalfEdgeMesh,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    areas: &[f64],
+    polygon: &Polygon,
+    system: LoopSystem,
+) -> Result<(f64, Marked), EmbeddingError> {
+    let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
+    let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
+    let genus = polygon.genus() as usize;
+    let canonical =
+        schema::canonicalize(&system.relation, system.generators.len()).map_err(fail)?;
+    let words: Vec<schema::Word> = canonical
+        .originals
+        .iter()
+        .map(|w| schema::dehn_reduce(w, genus))
+        .collect();
+    let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
+    let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
+    lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
+    let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
+    tracing::debug!(
+        base = system.base,
+        score,
+        "marking screened (area-weighted mean of squared log stretch)"
+    );
+    let marked = Marked {
+        system,
+        words,
+        closure_error,
+        lifts,
+    };
+    Ok((score, marked))
 }
 
 /// Sweeps each candidate marking is relaxed for before they are compared.

@@ -163,6 +163,8 @@ fn write_stdout(text: &str) -> anyhow::Result<()> {
 pub struct FitProgress {
     bar: indicatif::ProgressBar,
     estimate: std::cell::Cell<Option<f64>>,
+    /// The stage under way and when it began, so that `-v` logs how long each took.
+    current: std::cell::RefCell<Option<(String, std::time::Instant)>>,
 }
 
 /// Fits estimated to take less than this (seconds) get no estimate: they are done before it helps.
@@ -186,11 +188,14 @@ impl FitProgress {
         FitProgress {
             bar,
             estimate: std::cell::Cell::new(None),
+            current: std::cell::RefCell::new(None),
         }
     }
 
     /// Shows what is being done (with the estimate, once there is one).
     pub fn stage(&self, stage: &str) {
+        self.end_stage();
+        *self.current.borrow_mut() = Some((stage.to_string(), std::time::Instant::now()));
         self.bar
             .set_message(stage_message(stage, self.estimate.get()));
         self.bar.tick();
@@ -207,7 +212,16 @@ impl FitProgress {
     }
 
     pub fn finish(&self) {
+        self.end_stage();
         self.bar.finish_and_clear();
+    }
+
+    /// Logs (at info, `-v`) how long the stage under way took.
+    fn end_stage(&self) {
+        if let Some((stage, began)) = self.current.borrow_mut().take() {
+            let seconds = began.elapsed().as_secs_f64();
+            tracing::info!(target: "ntori", "{stage}: {seconds:.2} s");
+        }
     }
 }
 

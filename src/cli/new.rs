@@ -251,7 +251,11 @@ const SHAPE_SAMPLES: u32 = 16;
 /// keeps its crossings at 64. (Genus 16: 1.7 s at 32, 3.9 s at 48, 6.9 s at 64.)
 pub const INTERSECTION_SAMPLES: [u32; 3] = [32, 48, 64];
 
-fn measure_shape(fitted: &Fitted, diagonal: f64) -> Result<ShapeReport, embedding::EmbeddingError> {
+fn measure_shape(
+    fitted: &Fitted,
+    diagonal: f64,
+    stage: &dyn Fn(&str),
+) -> Result<ShapeReport, embedding::EmbeddingError> {
     use embedding::quality;
     let surface = fitted.surface;
     let points = quality::sample_points(surface, SHAPE_SAMPLES)?;
@@ -267,6 +271,7 @@ fn measure_shape(fitted: &Fitted, diagonal: f64) -> Result<ShapeReport, embeddin
         }
     };
     let normals = quality::normal_deviation_from(surface, at, reference);
+    stage("looking for self-intersections");
     let crossings = quality::crossings_until_clear(surface, &INTERSECTION_SAMPLES)?;
     let (first, last) = (crossings[0], crossings[crossings.len() - 1]);
     let input_curvature =
@@ -394,7 +399,7 @@ pub fn check(
     let curvature_error =
         (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
     stage("measuring the shape");
-    let shape = measure_shape(fitted, mesh_diagonal)?;
+    let shape = measure_shape(fitted, mesh_diagonal, stage)?;
     let shape_verdict = shape.verdict();
     Ok(NewReport {
         genus,
