@@ -70,7 +70,7 @@ fn whole_mesh_fit(c: &mut Criterion, resolution: usize) {
 
 /// The genus-8 plate at `resolution` (42: 64 k triangles), split 1-to-4 twice (about 10⁶): its
 /// greedy loop system through one vertex (shortest-path tree, cotree, the 2g shortest loops) and
-/// the loops' canonical words. (The plates themselves are capped at the fit's 200 000 triangles.)
+/// the loops' canonical words. (The plates themselves are capped at the fit's 400 000 triangles.)
 fn loops(c: &mut Criterion, resolution: usize) {
     let plate = HoledMesh::new(8, resolution).unwrap();
     let (positions, triangles) = split(split((plate.positions, plate.triangles)));

@@ -249,14 +249,18 @@ pub struct InitialFit {
     pub mesh_diagonal: f64,
 }
 
-/// Peak memory of the initial fit per input triangle, measured with `ntori new` at genus 2: 851 MB
-/// for 42 732 triangles (resolution 64), 3.56 GB for 169 556 (resolution 128); the sparse
-/// factorizations dominate. Rounded up.
-pub const FIT_BYTES_PER_TRIANGLE: u64 = 21_000;
-/// The most input triangles [`initial_model`] fits: about 4.2 GB at the rate above. Genus 16 at
-/// resolution 32 (115 384 triangles) is within the cap; genus 64 exceeds it even at resolution 8,
-/// so no genus-64 fit is possible on this path.
-pub const MAX_FIT_TRIANGLES: usize = 200_000;
+/// Peak memory of the initial fit per input triangle, measured with `ntori new` (release): 1.29 GB
+/// for genus 2's 169 556 triangles (resolution 128), 1.99 GB for genus 64's 223 516 (resolution
+/// 8); the map's sparse LU factorizations dominate. Rounded up. (With the fit's least squares by
+/// sparse QR, before the seminormal equations, it was 21 000: 3.56 GB for genus 2 at 128.)
+pub const FIT_BYTES_PER_TRIANGLE: u64 = 10_000;
+/// The most input triangles [`initial_model`] and [`crate::mesh_fit::mesh_model`] fit: about 4 GB
+/// at the rate above. Every genus up to 64 fits at resolution 8 (genus 64: 223 516 triangles).
+pub const MAX_FIT_TRIANGLES: usize = 400_000;
+/// The most input triangles [`default_resolution`] chooses: the map's time grows faster than its
+/// size (genus 2: 0.65 s for 10 948 triangles, 8.4 s for 42 732, 100 s for 169 556), so a genus
+/// whose default mesh would be finer gets a coarser one; `--resolution` can go up to the cap.
+pub const DEFAULT_FIT_TRIANGLES: usize = 200_000;
 
 /// A stage of [`initial_model_with_progress`], for progress displays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -301,7 +305,7 @@ pub const DEFAULT_RESOLUTION: usize = 32;
 /// resolution): genus 16 and 20 pass every check at 32 (Gauss–Bonnet 9.4e-6 and 6.8e-4); genus 24
 /// at 32 misses Gauss–Bonnet by 7% and its t = 64 tessellation crosses itself in 223 pairs (∫K dA
 /// does not settle with the quadrature: K spikes between samples), and at 40 passes every check
-/// (Gauss–Bonnet 4.7e-4, no crossings; 118 s, 3.6 GB). Genus 32 fails at 32 and at 48 alike.
+/// (Gauss–Bonnet 4.7e-4, no crossings; 86 s, 1.3 GB). Genus 32 fails at 32 and at 48 alike.
 pub fn default_grid(genus: u32) -> usize {
     if genus <= 20 {
         SplineSettings::default().grid
@@ -311,17 +315,17 @@ pub fn default_grid(genus: u32) -> usize {
 }
 
 /// The resolution `ntori new` and the editor use for `genus`: [`DEFAULT_RESOLUTION`], or where that
-/// mesh has more triangles than the fit takes ([`MAX_FIT_TRIANGLES`]; genus 24 and 32, not 16),
-/// nearly the finest that fits (the plates' triangles grow as the resolution's square): genus 24
-/// gets 28, 32 gets 21. Where even resolution 8 is too fine, 8, which the fit then refuses.
+/// mesh has more than [`DEFAULT_FIT_TRIANGLES`] (genus 24 and 32, not 16), nearly the finest within
+/// it (the plates' triangles grow as the resolution's square): genus 24 gets 28, 32 gets 21. Where
+/// even resolution 8 has more, 8 (genus 64: 223 516 triangles, within [`MAX_FIT_TRIANGLES`]).
 pub fn default_resolution(genus: u32) -> Result<usize, EmbeddingError> {
     let mut resolution = DEFAULT_RESOLUTION;
     loop {
         let triangles = HoledMesh::new(genus, resolution)?.triangles.len();
-        if triangles <= MAX_FIT_TRIANGLES || resolution <= 8 {
+        if triangles <= DEFAULT_FIT_TRIANGLES || resolution <= 8 {
             return Ok(resolution);
         }
-        let scale = (MAX_FIT_TRIANGLES as f64 / triangles as f64).sqrt();
+        let scale = (DEFAULT_FIT_TRIANGLES as f64 / triangles as f64).sqrt();
         resolution = ((0.97 * scale * resolution as f64) as usize).clamp(8, resolution - 1);
     }
 }

@@ -170,13 +170,16 @@ pub struct FitProgress {
 /// Fits estimated to take less than this (seconds) get no estimate: they are done before it helps.
 const LONG_FIT_SECONDS: f64 = 10.0;
 
-/// About how long a fit of `triangles` input triangles takes, in seconds: 2 s plus 0.3 ms a
-/// triangle. Measured with release builds on the project's 2-core machine: `ntori new` at genus
-/// 3, 5, 8, 10 and 16 (11 k to 115 k triangles) took 4.7, 7.4, 11.6, 15.2 and 36.4 s (the rule:
-/// 5.3, 7.8, 13.1, 17.6, 36.6); `ntori fit` of the 3170-triangle plate 3.2 s (3.0); a subdivision
-/// cage's 25 600-triangle limit mesh 16.7 s (9.7: the rule is no closer than a factor of two).
+/// About how long a fit of `triangles` input triangles takes, in seconds: 1 s, 0.1 ms a triangle,
+/// and a term in the square of the size (the map's sparse factorizations grow faster than the
+/// mesh). Measured with release builds on the project's 2-core machine, `ntori new` with its
+/// checks: genus 2, 10, 16 and 24 (11 k, 52 k, 115 k and 189 k triangles) took 1.8, 7.8, 29 and
+/// 86 s (the rule: 2.3, 10.2, 32 and 73 s); `ntori fit` of a 20 k-triangle genus-4 mesh 7.0 s (3.7:
+/// a user's mesh screens several markings); genus 64's 224 k triangles 308 s (98: it takes 23
+/// factorizations where genus 2 takes 4). The rule is no closer than a factor of two or three.
 pub fn estimated_fit_seconds(triangles: usize) -> f64 {
-    2.0 + 3e-4 * triangles as f64
+    let n = triangles as f64;
+    1.0 + 1e-4 * n + 1.5e-9 * n * n
 }
 
 impl FitProgress {

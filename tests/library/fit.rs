@@ -425,10 +425,13 @@ fn the_default_grid_is_32_up_to_genus_20_and_40_above() {
     }
 }
 
-/// Without a chosen resolution, high genus gets the finest mesh the fit takes, not a refusal.
+/// Without a chosen resolution, high genus gets nearly the finest mesh within the default budget,
+/// and genus 64 the coarsest, which the fit takes: never a refusal.
 #[test]
 fn the_default_resolution_keeps_high_genus_within_the_fit() {
-    use embedding::fit::{DEFAULT_RESOLUTION, MAX_FIT_TRIANGLES, default_resolution};
+    use embedding::fit::{
+        DEFAULT_FIT_TRIANGLES, DEFAULT_RESOLUTION, MAX_FIT_TRIANGLES, default_resolution,
+    };
     for genus in [0, 2, 8, 16] {
         assert_eq!(default_resolution(genus).unwrap(), DEFAULT_RESOLUTION);
     }
@@ -438,8 +441,14 @@ fn the_default_resolution_keeps_high_genus_within_the_fit() {
         eprintln!("genus {genus}: resolution {resolution}, {triangles} triangles");
         assert!(resolution < DEFAULT_RESOLUTION, "genus {genus}");
         assert!(
-            triangles <= MAX_FIT_TRIANGLES && 10 * triangles >= 8 * MAX_FIT_TRIANGLES,
+            triangles <= DEFAULT_FIT_TRIANGLES && 10 * triangles >= 8 * DEFAULT_FIT_TRIANGLES,
             "genus {genus}: {triangles} triangles at resolution {resolution}"
         );
     }
+    assert_eq!(default_resolution(64).unwrap(), 8);
+    let triangles = HoledMesh::new(64, 8).unwrap().triangles.len();
+    assert!(
+        triangles > DEFAULT_FIT_TRIANGLES && triangles <= MAX_FIT_TRIANGLES,
+        "{triangles}"
+    );
 }

@@ -5,7 +5,7 @@
 //! into triangles, which the fit then takes like any other mesh, with the limit normals as the
 //! intended shape's.
 
-use embedding::fit::MAX_FIT_TRIANGLES;
+use embedding::fit::{DEFAULT_FIT_TRIANGLES, MAX_FIT_TRIANGLES};
 use embedding::{Point3, Vector3};
 
 use super::{ImportError, ImportedMesh, Polygons, ValidMesh};
@@ -124,14 +124,15 @@ fn triangles_at(corners: usize, level: u32) -> usize {
 }
 
 /// The fewest levels from 2 that make [`CAGE_TRIANGLES`], or, for a cage so fine that this is
-/// more than the fit takes, the most that fit (down to 1).
+/// more than a default fit takes ([`DEFAULT_FIT_TRIANGLES`], for time), the most within it (down
+/// to 1; `--cage-level` may go up to [`MAX_FIT_TRIANGLES`]).
 fn default_level(corners: usize) -> u32 {
     let wanted = (2..MAX_CAGE_LEVEL)
         .find(|&l| triangles_at(corners, l) >= CAGE_TRIANGLES)
         .unwrap_or(MAX_CAGE_LEVEL);
     (1..=wanted)
         .rev()
-        .find(|&l| triangles_at(corners, l) <= MAX_FIT_TRIANGLES)
+        .find(|&l| triangles_at(corners, l) <= DEFAULT_FIT_TRIANGLES)
         .unwrap_or(1)
 }
 
@@ -172,8 +173,8 @@ mod tests {
         // The slab cage's 200 corners: 6 400 triangles at 3, 25 600 at 4.
         assert_eq!(triangles_at(200, 3), 6_400);
         assert_eq!(default_level(200), 4);
-        // A cage of 8 000 quads (32 000 corners): 256 000 triangles at 2 are more than the fit
-        // takes, 64 000 at 1 are not.
+        // A cage of 8 000 quads (32 000 corners): 256 000 triangles at 2 are more than a default
+        // fit takes, 64 000 at 1 are not.
         assert_eq!(default_level(32_000), 1);
         // A tetrahedron's 12 corners: 12 · 4⁵ · 2 = 24 576 triangles at 6 (the most levels).
         assert_eq!(default_level(12), 6);
