@@ -143,11 +143,12 @@ pub fn max_principal_curvature(surface: &Surface, points: &[ChartPoint]) -> Curv
     out
 }
 
-/// Angles in degrees: the median, the 90th percentile and the largest.
+/// Angles in degrees: the median, the 90th and 95th percentiles and the largest.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AngleSpread {
     pub median: f64,
     pub p90: f64,
+    pub p95: f64,
     pub max: f64,
 }
 
@@ -161,6 +162,7 @@ impl AngleSpread {
         AngleSpread {
             median: at(0.5),
             p90: at(0.9),
+            p95: at(0.95),
             max: angles[angles.len() - 1],
         }
     }
@@ -271,6 +273,37 @@ pub fn tessellation_crossings(surface: &Surface, t: u32) -> Result<usize, Embedd
         &mut |s: &evaluate::Sample| positions[s.index] = s.position.coords.into(),
     );
     Ok(mesh::spatial::self_intersections(&positions, &tessellation.triangles)?.len())
+}
+
+/// The two-sided Hausdorff distance between the surface's t × t tessellation (mesh a) and a mesh
+/// (b: `positions`, `triangles`), sampled as [`mesh::spatial::hausdorff`] does: how far a fit
+/// strays from the mesh it was fitted to, and the mesh from it, between the vertices as well as at
+/// them (the fit's residual sees only the vertices).
+pub fn hausdorff_to_mesh(
+    surface: &Surface,
+    t: u32,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+) -> Result<mesh::spatial::Hausdorff, EmbeddingError> {
+    let tessellation = surface.atlas().tessellate(t, t)?;
+    let mut tessellated = vec![[0.0; 3]; tessellation.vertices.len()];
+    evaluate::evaluate(
+        surface,
+        &tessellation.vertices,
+        evaluate::Wants::default(),
+        0.0,
+        &mut |s: &evaluate::Sample| tessellated[s.index] = s.position.coords.into(),
+    );
+    let input: Vec<[f64; 3]> = positions.iter().map(|p| p.coords.into()).collect();
+    let a = mesh::spatial::MeshRef {
+        positions: &tessellated,
+        triangles: &tessellation.triangles,
+    };
+    let b = mesh::spatial::MeshRef {
+        positions: &input,
+        triangles,
+    };
+    Ok(mesh::spatial::hausdorff(a, b)?)
 }
 
 /// [`tessellation_crossings`] at each resolution of `ts` in turn (coarse to fine), up to the first

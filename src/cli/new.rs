@@ -240,7 +240,14 @@ pub struct ShapeReport {
     pub self_intersections: usize,
     pub intersection_samples: u32,
     pub coarse_crossings: usize,
+    /// The two-sided Hausdorff distance between the surface's t_e = t_r = [`DISTANCE_SAMPLES`]
+    /// tessellation and the input mesh, as a fraction of the diagonal: how far apart they are
+    /// anywhere, where the residual sees only the mesh's vertices. Reported, not gated.
+    pub distance_to_input: f64,
 }
+
+/// The tessellation (t_e = t_r) the distance to the input is measured from.
+pub const DISTANCE_SAMPLES: u32 = 32;
 
 /// The tessellation the shape measures sample (t_e = t_r).
 const SHAPE_SAMPLES: u32 = 16;
@@ -271,6 +278,13 @@ fn measure_shape(
         }
     };
     let normals = quality::normal_deviation_from(surface, at, reference);
+    stage("measuring the distance to the input");
+    let distance = quality::hausdorff_to_mesh(
+        surface,
+        DISTANCE_SAMPLES,
+        fitted.positions,
+        fitted.triangles,
+    )?;
     stage("looking for self-intersections");
     let crossings = quality::crossings_until_clear(surface, &INTERSECTION_SAMPLES)?;
     let (first, last) = (crossings[0], crossings[crossings.len() - 1]);
@@ -288,6 +302,7 @@ fn measure_shape(
         self_intersections: last.1,
         intersection_samples: last.0,
         coarse_crossings: if crossings.len() > 1 { first.1 } else { 0 },
+        distance_to_input: distance.symmetric / diagonal,
     })
 }
 
@@ -511,6 +526,8 @@ impl NewReport {
              input mesh: {v} vertices, {f} triangles, bounding-box diagonal {diag:.3}\n\
              parameterization: {solve}, {folded} folded triangles ({bij}){distortion}\n\
              fit residual: rms {rms:.3}%, max {max:.3}% of the diagonal ({res})\n\
+             distance: surface and input mesh within {dist:.3}% of the diagonal of each other \
+             (Hausdorff, t_e = t_r = {dist_t})\n\
              Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, relative error {gb:.1e} ({gbv})\n\
              patches: disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%) ({pdv})\n\
              curvature: largest |κ| {kmax:.2}, {ratio:.2}× the input's {kin:.2} ({kv})\n\
@@ -532,6 +549,8 @@ impl NewReport {
             rms = 100.0 * self.rms_residual,
             max = 100.0 * self.max_residual,
             res = verdict(self.max_residual <= RESIDUAL_TOLERANCE),
+            dist = 100.0 * self.shape.distance_to_input,
+            dist_t = DISTANCE_SAMPLES,
             k = self.total_curvature,
             e = self.expected_curvature,
             gb = self.curvature_error,

@@ -1,0 +1,119 @@
+//! Issue 14's acceptance measures on meshes that are not plates: a knotted tube (genus 1), a
+//! pretzel (genus 3), a cube with tunnels (genus 5), and a plate of about 200 000 triangles, each
+//! fitted as a user's mesh (`mesh_model`, `ntori fit`'s grid): folds, the two-sided Hausdorff
+//! distance between the input and the surface's t = 32 tessellation, the normals against the mesh's
+//! own at the 95th percentile, Gauss–Bonnet, the loops' canonical words, and the time.
+//!
+//! `cargo run --release -p embedding --example acceptance [SCALE] [--large]`: SCALE (default 1)
+//! multiplies each mesh's resolution; `--large` adds the 200 000-triangle plate (minutes).
+#[path = "../tests/shapes/mod.rs"]
+mod shapes;
+
+use std::time::Instant;
+
+use embedding::fit::FitSettings;
+use embedding::holed::HoledMesh;
+use embedding::integrals::{cells_per_knot, surface_integrals};
+use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
+use embedding::quality;
+use embedding::{Point3, SplineSettings};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let scale: f64 = args.iter().find_map(|a| a.parse().ok()).unwrap_or(1.0);
+    let mut cases: Vec<(&str, shapes::Mesh)> = vec![
+        (
+            "trefoil tube",
+            shapes::trefoil_tube((160.0 * scale) as usize, (16.0 * scale) as usize, 0.45),
+        ),
+        ("pretzel", shapes::pretzel(0.12 / scale)),
+        ("cube with tunnels", shapes::cube_with_tunnels(0.1 / scale)),
+        (
+            "pretzel, evened out",
+            shapes::even_pretzel(0.12 / scale, 10),
+        ),
+        (
+            "cube with tunnels, evened out",
+            shapes::even_cube_with_tunnels(0.1 / scale, 10),
+        ),
+    ];
+    if args.iter().any(|a| a == "--large") {
+        let plate = HoledMesh::new(4, 170).expect("a plate");
+        cases.push(("genus-4 plate, large", (plate.positions, plate.triangles)));
+    }
+    for (name, (positions, triangles)) in &cases {
+        report(name, positions, triangles);
+    }
+}
+
+fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
+    let grid = std::env::var("GRID")
+        .ok()
+        .and_then(|g| g.parse().ok())
+        .unwrap_or(MESH_FIT_GRID);
+    let settings = SplineSettings {
+        grid,
+        ..SplineSettings::default()
+    };
+    let start = Instant::now();
+    let rounds = std::env::var("ROUNDS")
+        .ok()
+        .and_then(|g| g.parse().ok())
+        .unwrap_or(1);
+    let fit_settings = FitSettings {
+        stretch_rounds: rounds,
+        ..FitSettings::default()
+    };
+    let fit = match mesh_model(positions, triangles, settings, fit_settings, &|_| {}) {
+        Ok(fit) => fit,
+        Err(e) => {
+            println!(
+                "{name}: {} vertices, {} triangles: {e}",
+                positions.len(),
+                triangles.len()
+            );
+            return;
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let diagonal = fit.mesh_diagonal;
+    let surface = &fit.surface;
+    let distance = quality::hausdorff_to_mesh(surface, 32, positions, triangles).expect("measured");
+    let normals =
+        quality::normal_deviation(surface, &fit.parameterization.points, positions, triangles);
+    let layout = surface.layout();
+    let sums = surface_integrals(
+        &layout,
+        surface.control_points(),
+        cells_per_knot(layout.settings()),
+    );
+    let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(fit.genus));
+    let gauss_bonnet =
+        (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
+    if let Some(d) = fit.parameterization.map_distortion {
+        println!("  map distortion: {d:?}");
+    }
+    let longest_word = fit.loops.canonical.iter().map(Vec::len).max().unwrap_or(0);
+    println!(
+        "{name}: {} vertices, {} triangles, genus {}, fitted in {seconds:.1} s\n  \
+         folded {}, residual max {:.3}% of the diagonal, Hausdorff {:.3}% (input to surface \
+         {:.3}%, surface to input {:.3}%)\n  normals median {:.2}°, 90% {:.2}°, 95% {:.2}°, max \
+         {:.1}°; Gauss–Bonnet {gauss_bonnet:.1e}\n  loops: {} through vertex {}, relation of {} \
+         letters, canonical words of up to {longest_word} letters",
+        positions.len(),
+        triangles.len(),
+        fit.genus,
+        fit.parameterization.folded,
+        100.0 * fit.max_residual / diagonal,
+        100.0 * distance.symmetric / diagonal,
+        100.0 * distance.b_to_a / diagonal,
+        100.0 * distance.a_to_b / diagonal,
+        normals.median,
+        normals.p90,
+        normals.p95,
+        normals.max,
+        fit.loops.paths.len(),
+        fit.loops.base,
+        fit.loops.relation.len(),
+    );
+}
