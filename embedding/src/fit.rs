@@ -321,7 +321,13 @@ pub fn default_grid(genus: u32) -> usize {
 pub fn default_resolution(genus: u32) -> Result<usize, EmbeddingError> {
     let mut resolution = DEFAULT_RESOLUTION;
     loop {
-        let triangles = HoledMesh::new(genus, resolution)?.triangles.len();
+        let triangles = match HoledMesh::new(genus, resolution) {
+            Ok(mesh) => mesh.triangles.len(),
+            // Refused as too fine for the fit at all: the count it gives (at least that many) is
+            // enough to scale down from.
+            Err(EmbeddingError::FitTooLarge { triangles, .. }) if resolution > 8 => triangles,
+            Err(e) => return Err(e),
+        };
         if triangles <= DEFAULT_FIT_TRIANGLES || resolution <= 8 {
             return Ok(resolution);
         }

@@ -212,11 +212,12 @@ fn fits_beyond_the_memory_cap_are_refused_before_fitting() {
     use embedding::EmbeddingError;
     use embedding::fit::{FitSettings, MAX_FIT_TRIANGLES, initial_model};
     let settings = embedding::SplineSettings::default();
-    // Genus 64 at resolution 24 makes far more triangles than the cap (at 8 it makes 223 516), and
-    // is refused before it is meshed, from a lower bound on the count ("more than").
+    // Genus 64 at resolution 48 makes far more triangles than the cap (at 8 it makes 223 516, at
+    // 24 928 100), and is refused before it is meshed, from a lower bound on the count ("more
+    // than").
     let started = std::time::Instant::now();
-    let Err(err) = initial_model(64, 24, settings, FitSettings::default()) else {
-        panic!("genus 64 at resolution 24 is refused");
+    let Err(err) = initial_model(64, 48, settings, FitSettings::default()) else {
+        panic!("genus 64 at resolution 48 is refused");
     };
     let EmbeddingError::FitTooLarge {
         triangles,
