@@ -1101,8 +1101,9 @@ pub fn klein_to_poincare(k: Complex64) -> Complex64 {
 // ------------------------------------------------------------------------------------------ fit
 
 /// Least-squares control points: Σ_i w_i |S(p_i) − P_i|² + smoothness, solved at once for every
-/// chart by one sparse factorisation (the three coordinates share it; see [`least_squares`]). `weights` are per-point
-/// weights (e.g. vertex areas; normalised here to mean 1).
+/// chart by one sparse factorisation (the three coordinates share it): the normal equations by
+/// sparse Cholesky with one refinement step. `weights` are per-point weights (e.g. vertex areas;
+/// normalised here to mean 1).
 pub fn fit(
     layout: &Layout,
     points: &[ChartPoint],
