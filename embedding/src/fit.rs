@@ -835,6 +835,40 @@ impl Lifts {
         }
     }
 
+    /// Moves every vertex's home lift into the polygon (by the side pairings that bring it there),
+    /// and the group elements that see its neighbours and its triangles along with it; the map on
+    /// the surface is the same. A user's mesh starts with every vertex at the origin, and the
+    /// sweeps then carry whole regions into tiles far from the polygon (the cube with tunnels of
+    /// `embedding/tests/shapes`: |z| up to 1 − 4e-8), where the disk's coordinates lose the digits
+    /// that tell neighbours apart; Newton's method stalled there (the residual stuck at 3e-5). Only
+    /// for maps not made from a cut disk (whose copies are tied to the homes) and in the hyperbolic
+    /// disk (the plane has no boundary to lose digits at).
+    pub(crate) fn rehome(&mut self, polygon: &Polygon) {
+        if !self.to_copy.is_empty() || polygon.geometry() != Geometry::Hyperbolic {
+            return;
+        }
+        let moves: Vec<Lft> = self
+            .home
+            .iter_mut()
+            .map(|z| {
+                let (reduced, h) = polygon.reduce_with_map(*z);
+                *z = reduced;
+                h
+            })
+            .collect();
+        let inverses: Vec<Lft> = moves.iter().map(Lft::inverse).collect();
+        for (v, around) in self.neighbours.iter_mut().enumerate() {
+            for (_, u, g) in around.iter_mut() {
+                *g = moves[v].compose(&g.compose(&inverses[*u as usize]));
+            }
+        }
+        for corners in &mut self.corners {
+            for (v, g) in corners.iter_mut() {
+                *g = g.compose(&inverses[*v as usize]);
+            }
+        }
+    }
+
     /// The map at its fixed point: [`WARMUP_SWEEPS`] sweeps to smooth the start, then Newton's
     /// method to [`RELAX_TOLERANCE`] (see [`crate::harmonic`]).
     pub(crate) fn settle(&mut self, hyperbolic: bool) -> Result<Convergence, EmbeddingError> {

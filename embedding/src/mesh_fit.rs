@@ -348,6 +348,7 @@ fn screen(
     let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
     let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
     lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
+    lifts.rehome(polygon);
     let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
     tracing::debug!(
         base = system.base,

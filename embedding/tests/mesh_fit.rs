@@ -339,3 +339,27 @@ fn irregular_meshes_of_other_shapes_fit_without_folds() {
         assert_eq!(fit.parameterization.points.len(), positions.len());
     }
 }
+
+/// Marching tetrahedra's cube with tunnels at cell 0.2 (4 200 triangles, genus 5): the sweeps carry
+/// whole regions of its map into tiles far out in the disk (|z| up to 1 − 4e-8), where Newton's
+/// method stalled with its residual at 3e-5 ("did not converge in 60 Newton steps") until the
+/// lifts were moved back into the polygon first (`Lifts::rehome`). Now the map converges. (It has a
+/// few folded triangles among the needles, and the shape is far off; see the test above.)
+#[test]
+fn a_map_that_wanders_far_into_the_disk_still_converges() {
+    let (positions, triangles) = shapes::cube_with_tunnels(0.2);
+    let fit = mesh_model(
+        &positions,
+        &triangles,
+        SplineSettings::default(),
+        FitSettings::default(),
+        &|_| {},
+    )
+    .unwrap();
+    assert_eq!(fit.genus, 5);
+    let solved = fit.parameterization.newton.expect("Newton's method ran");
+    assert!(
+        solved.residual <= embedding::fit::RELAX_TOLERANCE,
+        "{solved:?}"
+    );
+}
