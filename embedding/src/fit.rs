@@ -258,7 +258,8 @@ pub const FIT_BYTES_PER_TRIANGLE: u64 = 10_000;
 /// at the rate above. Every genus up to 64 fits at resolution 8 (genus 64: 223 516 triangles).
 pub const MAX_FIT_TRIANGLES: usize = 400_000;
 /// The most input triangles [`default_resolution`] chooses: the map's time grows faster than its
-/// size (genus 2: 0.65 s for 10 948 triangles, 8.4 s for 42 732, 100 s for 169 556), so a genus
+/// size (genus 2: 0.65 s for 10 948 triangles, 6.8 s for 42 732, 100 s for 169 556 measured
+/// before the symbolic analysis was reused, which saved about a fifth), so a genus
 /// whose default mesh would be finer gets a coarser one; `--resolution` can go up to the cap.
 pub const DEFAULT_FIT_TRIANGLES: usize = 200_000;
 
