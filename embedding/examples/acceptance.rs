@@ -87,9 +87,7 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
         surface.control_points(),
         cells_per_knot(layout.settings()),
     );
-    let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(fit.genus));
-    let gauss_bonnet =
-        (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
+    let gauss_bonnet = sums.gauss_bonnet_error(fit.genus);
     if let Some(d) = fit.parameterization.map_distortion {
         println!("  map distortion: {d:?}");
     }

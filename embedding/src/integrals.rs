@@ -31,6 +31,15 @@ pub struct SurfaceIntegrals {
     pub area: f64,
 }
 
+impl SurfaceIntegrals {
+    /// How far ∫K dA is from Gauss–Bonnet's 2π(2 − 2n) for a surface of `genus` n, relative to
+    /// the larger of that and ∫|K| dA (the torus's 2π(2 − 2n) is 0).
+    pub fn gauss_bonnet_error(&self, genus: u32) -> f64 {
+        let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
+        (self.gaussian_curvature - expected).abs() / expected.abs().max(self.absolute_curvature)
+    }
+}
+
 /// Four-point Gauss–Legendre on [−1, 1].
 const NODES: [(f64, f64); 4] = [
     (-0.861_136_311_594_052_6, 0.347_854_845_137_453_8),
@@ -81,7 +90,11 @@ pub fn surface_integrals(
                 }
                 let p = ChartPoint::new(chart.id(), w);
                 let reps = layout.atlas().locate_with_transitions(p);
-                let own = normalised_blend(layout, chart, &reps);
+                let own = layout
+                    .blends_located(&reps)
+                    .into_iter()
+                    .find(|b| b.0 == chart.id())
+                    .map_or(0.0, |b| b.1);
                 if own == 0.0 {
                     continue;
                 }
@@ -102,25 +115,6 @@ pub fn surface_integrals(
             absolute_curvature: a.absolute_curvature + b.absolute_curvature,
             area: a.area + b.area,
         })
-}
-
-/// The normalised blend b̂ of `chart` at a point whose representatives are `reps` (which include
-/// the point itself in `chart`).
-fn normalised_blend(
-    layout: &Layout,
-    chart: &charts::Chart,
-    reps: &[(ChartPoint, charts::Lft)],
-) -> f64 {
-    let raw = |rep: &ChartPoint| {
-        layout.raw_blend_value(
-            layout.atlas().charts()[rep.chart.index()].domain(),
-            rep.coords,
-        )
-    };
-    let total: f64 = reps.iter().map(|(r, _)| raw(r)).sum();
-    reps.iter()
-        .find(|(r, _)| r.chart == chart.id())
-        .map_or(0.0, |(r, _)| raw(r) / total)
 }
 
 /// Quadrature points and weights along [−½, ½] in `cells` cells of width `h`.

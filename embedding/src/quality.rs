@@ -263,6 +263,15 @@ fn triangle_max_curvature(p: [Point3; 3], n: [Vector3; 3]) -> Option<f64> {
 /// Pairs of triangles of the surface's t × t tessellation that cross (share no vertex or edge and
 /// meet, by exact predicates): 0 for an embedded surface, at that resolution.
 pub fn tessellation_crossings(surface: &Surface, t: u32) -> Result<usize, EmbeddingError> {
+    let (positions, triangles) = tessellated(surface, t)?;
+    Ok(mesh::spatial::self_intersections(&positions, &triangles)?.len())
+}
+
+/// A triangle mesh as plain arrays: positions and corner indices.
+type PlainMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// The surface's t × t tessellation, evaluated: its vertices' positions and its triangles.
+fn tessellated(surface: &Surface, t: u32) -> Result<PlainMesh, EmbeddingError> {
     let tessellation = surface.atlas().tessellate(t, t)?;
     let mut positions = vec![[0.0; 3]; tessellation.vertices.len()];
     evaluate::evaluate(
@@ -272,7 +281,7 @@ pub fn tessellation_crossings(surface: &Surface, t: u32) -> Result<usize, Embedd
         0.0,
         &mut |s: &evaluate::Sample| positions[s.index] = s.position.coords.into(),
     );
-    Ok(mesh::spatial::self_intersections(&positions, &tessellation.triangles)?.len())
+    Ok((positions, tessellation.triangles))
 }
 
 /// The two-sided Hausdorff distance between the surface's t × t tessellation (mesh a) and a mesh
@@ -285,19 +294,11 @@ pub fn hausdorff_to_mesh(
     positions: &[Point3],
     triangles: &[[u32; 3]],
 ) -> Result<mesh::spatial::Hausdorff, EmbeddingError> {
-    let tessellation = surface.atlas().tessellate(t, t)?;
-    let mut tessellated = vec![[0.0; 3]; tessellation.vertices.len()];
-    evaluate::evaluate(
-        surface,
-        &tessellation.vertices,
-        evaluate::Wants::default(),
-        0.0,
-        &mut |s: &evaluate::Sample| tessellated[s.index] = s.position.coords.into(),
-    );
+    let (surface_positions, surface_triangles) = tessellated(surface, t)?;
     let input: Vec<[f64; 3]> = positions.iter().map(|p| p.coords.into()).collect();
     let a = mesh::spatial::MeshRef {
-        positions: &tessellated,
-        triangles: &tessellation.triangles,
+        positions: &surface_positions,
+        triangles: &surface_triangles,
     };
     let b = mesh::spatial::MeshRef {
         positions: &input,

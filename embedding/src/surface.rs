@@ -337,7 +337,12 @@ impl<'a> Layout<'a> {
 
     /// The normalised blend of each chart holding `p` (they sum to 1), in chart order.
     pub fn blends(&self, p: ChartPoint) -> Vec<(ChartId, f64)> {
-        let reps = self.atlas.locate_with_transitions(p);
+        self.blends_located(&self.atlas.locate_with_transitions(p))
+    }
+
+    /// [`Layout::blends`] where the point is already located: `reps` is what
+    /// [`Atlas::locate_with_transitions`] gives for it.
+    pub(crate) fn blends_located(&self, reps: &[(ChartPoint, Lft)]) -> Vec<(ChartId, f64)> {
         let raw: Vec<f64> = reps
             .iter()
             .map(|(r, _)| {

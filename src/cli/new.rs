@@ -411,8 +411,7 @@ pub fn check(
     let cells = cells_per_knot(layout.settings());
     let sums = surface_integrals(&layout, surface.control_points(), cells);
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
-    let curvature_error =
-        (sums.gaussian_curvature - expected).abs() / expected.abs().max(sums.absolute_curvature);
+    let curvature_error = sums.gauss_bonnet_error(genus);
     stage("measuring the shape");
     let shape = measure_shape(fitted, mesh_diagonal, stage)?;
     let shape_verdict = shape.verdict();
