@@ -1323,7 +1323,8 @@ fn asymmetry(state: &EditorState, centre: Point3, radius: f64, signs: Vector3) -
 
 /// Σ H² dA over the vertices within `radius` of `centre`: the bending energy there.
 fn bending_energy(state: &mut EditorState, centre: Point3, radius: f64) -> f64 {
-    state.mesh_mut().refresh_brush_weights();
+    let surface = state.surface().clone();
+    state.mesh_mut().refresh_brush_weights(&surface).unwrap();
     let samples = state.mesh().brush_samples(state.surface());
     (0..samples.positions.len())
         .filter(|&r| (samples.positions[r] - centre).norm() < radius)

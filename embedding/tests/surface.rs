@@ -728,6 +728,37 @@ proptest! {
             prop_assert_eq!(jet.0, positions[r as usize]);
             prop_assert_eq!(jet.1, tangents[r as usize]);
         }
+        // After some control points move, the rows that use them are updated (to a fresh
+        // evaluation's very numbers), and every other row stays, where the f64 stencil says it
+        // moves by no more than the tensor stencil's own error.
+        let moved: Vec<u32> = (0..layout.control_count() as u32)
+            .filter(|c| (c ^ seed as u32) % 7 == 0)
+            .collect();
+        let mut after = control.clone();
+        for &c in &moved {
+            after[c as usize] += Vector3::new(1.0, -2.0, 0.5) * (1e-2 * diagonal);
+        }
+        let (mut updated, mut updated_tangents) = (positions.clone(), tangents.clone());
+        let rows = tensor.update_rows_of_controls(
+            &after,
+            &moved,
+            &mut updated,
+            &mut updated_tangents,
+            |p, t, position, tangents| (*p, *t) = (position, tangents),
+        );
+        prop_assert!(rows.windows(2).all(|w| w[0] < w[1]));
+        let mut fresh = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
+        tensor.positions_and_tangents(&after, &mut fresh.0, &mut fresh.1);
+        for r in 0..n {
+            if rows.binary_search(&(r as u32)).is_ok() {
+                prop_assert_eq!(updated[r], fresh.0[r]);
+                prop_assert_eq!(updated_tangents[r], fresh.1[r]);
+            } else {
+                prop_assert_eq!(updated[r], positions[r]);
+                let truth = exact_stencil.position(&after, r);
+                prop_assert!((truth - updated[r]).norm() <= 1e-6 * diagonal, "row {} left behind", r);
+            }
+        }
     }
 }
 

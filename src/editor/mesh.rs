@@ -10,7 +10,7 @@ use std::ops::Range;
 
 use bytemuck::{Pod, Zeroable};
 use charts::{ChartId, ChartPoint};
-use embedding::brush::BrushSamples;
+use embedding::brush::{BrushSamples, SurfaceSamples};
 use embedding::remesh::{QualitySettings, quality_mesh};
 use embedding::stencil::TensorStencil;
 use embedding::{
@@ -133,6 +133,11 @@ impl ChartTriangles {
     }
 }
 
+/// During a stroke, no vertex is further than this fraction of the model's size from where the
+/// control points put it (a tenth of a pixel where the model fills a 1000-pixel view): see
+/// [`LiveMesh::controls_moved`].
+pub const UNSEEN: f64 = 1e-4;
+
 /// The live surface mesh (see the module documentation).
 pub struct LiveMesh {
     pub tessellation: ChartTriangles,
@@ -150,12 +155,14 @@ pub struct LiveMesh {
     style: Style,
     /// The curvature style's colour range (kept during edits so colours stay comparable).
     curvature_range: Option<f64>,
-    /// The vertices' areas and the normal's orientation, for brushes: as of the last
-    /// [`LiveMesh::refresh_brush_weights`] (they weight a brush's samples; an edit changes them a
-    /// little, so a stroke's dabs use the areas of its start).
-    areas: Vec<f64>,
-    outward: f64,
+    /// The surface points brushes are fitted over (not these vertices: see
+    /// [`embedding::brush::SurfaceSamples`]), as of the last [`LiveMesh::refresh_brush_weights`]
+    /// and the dabs since.
+    samples: SurfaceSamples,
     size: f64,
+    /// Per control point, how far it has moved (summed) since the vertices it reaches were last
+    /// re-evaluated: see [`LiveMesh::controls_moved`].
+    pending: Vec<f64>,
     /// The f32 tensor stencil with tangents, made at the first stroke brush's dab: dabs move
     /// their vertices through it (several times faster than the f64 stencil), and the stroke's
     /// end makes them exact again.
@@ -187,40 +194,40 @@ impl LiveMesh {
             bvh_stale: true,
             style,
             curvature_range: None,
-            areas: Vec::new(),
-            outward: 1.0,
+            samples: SurfaceSamples::new(surface)?,
             size: 0.0,
+            pending: Vec::new(),
             tensor: None,
         };
         let all: Vec<u32> = (0..n as u32).collect();
         mesh.evaluate(surface, &all, true);
-        mesh.refresh_brush_weights();
+        mesh.refresh_size();
         mesh.bvh = Bvh::build(&mesh.positions, &mesh.tessellation.triangles);
         mesh.bvh_stale = false;
         Ok(mesh)
     }
 
-    /// Recomputes the vertices' areas and which way the normals point (see [`LiveMesh::brush_samples`]).
-    pub fn refresh_brush_weights(&mut self) {
-        self.areas = embedding::fit::vertex_areas(&self.positions, &self.tessellation.triangles);
-        self.outward = embedding::brush::outward(&self.positions, &self.tangents, &self.areas);
+    /// Brings the brush samples up to `surface` (their positions, areas and orientation; new
+    /// samples after a change of spline settings) and the model's size up to the vertices: at a
+    /// drag's or stroke's start, for edits, undo and refits may have happened since.
+    pub fn refresh_brush_weights(&mut self, surface: &Surface) -> Result<(), EditorError> {
+        if self.samples.fits(surface) {
+            self.samples.refresh(surface);
+        } else {
+            self.samples = SurfaceSamples::new(surface)?;
+        }
+        self.refresh_size();
+        Ok(())
+    }
+
+    fn refresh_size(&mut self) {
         let (lo, hi) = bounding_box(&self.positions);
         self.size = (hi - lo).norm();
     }
 
-    /// The tessellation as a brush samples it.
+    /// The surface as a brush samples it.
     pub fn brush_samples<'a>(&'a self, surface: &'a Surface) -> BrushSamples<'a> {
-        BrushSamples {
-            layout: surface.layout(),
-            control: surface.control_points(),
-            points: &self.tessellation.vertices,
-            stencil: &self.stencil,
-            columns: &self.columns,
-            positions: &self.positions,
-            tangents: &self.tangents,
-            areas: &self.areas,
-            outward: self.outward,
-        }
+        self.samples.view(surface)
     }
 
     pub fn stencil(&self) -> &Stencil {
@@ -352,33 +359,62 @@ impl LiveMesh {
             .rows_of_controls(&self.columns, controls.iter().map(|c| c.index()))
     }
 
-    /// After a brush's dab moved `controls`: the positions and tangents of the rows they touch
-    /// anew, through the f32 tensor stencil (to about 1e-7 of the model's size; made at the first
-    /// call), on all cores; call [`LiveMesh::controls_changed`] with every control point a stroke
-    /// moved when it ends, to make them exact. In the shaded and wireframe styles that is all a
-    /// vertex shows; in the others the colours follow too (the exact, full evaluation).
-    pub fn controls_moved(&mut self, surface: &Surface, controls: &[ControlId]) {
-        let rows = self.rows_of_controls(controls);
+    /// After a brush's dab moved control points (each with how far): the brush samples they reach
+    /// exactly, and the vertices through the f32 tensor stencil (to about 1e-7 of the model's size;
+    /// made at the first call), on all cores; call [`LiveMesh::controls_changed`] with every
+    /// control point a stroke moved when it ends, to make the vertices exact. In the shaded and
+    /// wireframe styles that is all a vertex shows; in the others the colours follow too (the
+    /// exact, full evaluation).
+    ///
+    /// Most of the control points a dab moves lie at its fringe and move very little, yet reach
+    /// half a million vertices at 10⁶. So a control point's vertices are re-evaluated only once
+    /// its motion since they last were adds up to [`UNSEEN`] of the model's size. The weights of a
+    /// row are positive and sum to 1, so no vertex is then ever further than that from where the
+    /// control points put it (a vertex re-evaluated for one control point takes the others'
+    /// motion so far along too).
+    pub fn controls_moved(&mut self, surface: &Surface, moved: &[(ControlId, Vector3)]) {
+        let controls: Vec<ControlId> = moved.iter().map(|m| m.0).collect();
+        self.samples.controls_moved(surface, &controls);
         if matches!(self.style, Style::Curvature(_) | Style::Charts) {
-            self.rows_changed(surface, &rows);
+            self.controls_changed(surface, &controls);
+            return;
+        }
+        self.pending.resize(surface.control_points().len(), 0.0);
+        let seen = UNSEEN * self.size;
+        let due: Vec<u32> = moved
+            .iter()
+            .filter_map(|&(c, d)| {
+                let pending = &mut self.pending[c.index()];
+                *pending += d.norm();
+                (*pending >= seen).then(|| {
+                    *pending = 0.0;
+                    c.0
+                })
+            })
+            .collect();
+        if due.is_empty() {
             return;
         }
         let points = &self.tessellation.vertices;
         let tensor = self
             .tensor
             .get_or_insert_with(|| TensorStencil::build_with_tangents(&surface.layout(), points));
-        let mut jets = vec![(Point3::origin(), [Vector3::zeros(); 2]); rows.len()];
-        tensor.rows_positions_and_tangents(surface.control_points(), &rows, &mut jets);
-        for (&r, (p, [u, v])) in rows.iter().zip(jets) {
-            let r = r as usize;
-            self.positions[r] = p;
-            self.tangents[r] = [u, v];
-            let n = u.cross(&v).normalize();
-            let vertex = &mut self.vertices[r];
-            vertex.position = [p.x as f32, p.y as f32, p.z as f32];
-            vertex.normal = [n.x as f32, n.y as f32, n.z as f32];
-            vertex.flags = 0;
-        }
+        // The vertex and its f64 position are written; the f64 tangents are left as they were
+        // (nothing reads them during a stroke, and its end makes them exact again): bytes a
+        // vertex need not move.
+        let rows = tensor.update_rows_of_controls(
+            surface.control_points(),
+            &due,
+            &mut self.positions,
+            &mut self.vertices,
+            |position, vertex, p, [u, v]| {
+                let n = u.cross(&v).normalize();
+                *position = p;
+                vertex.position = [p.x as f32, p.y as f32, p.z as f32];
+                vertex.normal = [n.x as f32, n.y as f32, n.z as f32];
+                vertex.flags = 0;
+            },
+        );
         self.dirty.add_sorted(&rows);
         self.bvh_stale = true;
     }
@@ -388,6 +424,11 @@ impl LiveMesh {
     pub fn controls_changed(&mut self, surface: &Surface, controls: &[ControlId]) {
         let rows = self.rows_of_controls(controls);
         self.rows_changed(surface, &rows);
+        for c in controls {
+            if let Some(pending) = self.pending.get_mut(c.index()) {
+                *pending = 0.0;
+            }
+        }
     }
 
     /// After the control points under `rows` (increasing) changed: their positions, tangents and,

@@ -442,7 +442,7 @@ impl EditorState {
             Grab::Pin(_) => Vec::new(),
         };
         if brush.is_some() {
-            self.mesh.refresh_brush_weights();
+            self.mesh.refresh_brush_weights(&self.surface)?;
         }
         let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, brush, &images)?;
         self.drag = Some(Drag {
@@ -471,7 +471,7 @@ impl EditorState {
             falloff: self.falloff,
             strength: self.strength,
         };
-        self.mesh.refresh_brush_weights();
+        self.mesh.refresh_brush_weights(&self.surface)?;
         self.stroke = Some(Stroke::new(brush, self.control().len()));
         self.stroke_at(point)
     }

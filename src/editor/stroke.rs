@@ -26,6 +26,8 @@ pub struct Stroke {
     /// Time spent in dabs (fit, control points and vertices), in total and the last one.
     pub busy: Duration,
     pub last_dab: Duration,
+    /// How many control points the last dab moved.
+    pub last_moved: usize,
 }
 
 impl Stroke {
@@ -37,6 +39,7 @@ impl Stroke {
             dabs: 0,
             busy: Duration::ZERO,
             last_dab: Duration::ZERO,
+            last_moved: 0,
         }
     }
 
@@ -66,10 +69,10 @@ impl Stroke {
             self.before[c.index()].get_or_insert(control[c.index()]);
         }
         surface.set_control_points_at(updates.iter().copied())?;
-        let ids: Vec<ControlId> = moved.iter().map(|m| m.0).collect();
-        mesh.controls_moved(surface, &ids);
+        mesh.controls_moved(surface, &moved);
         self.last = centres.first().map(|c| c.0);
         self.dabs += 1;
+        self.last_moved = moved.len();
         self.last_dab = started.elapsed();
         self.busy += self.last_dab;
         Ok(moved.len())

@@ -235,6 +235,11 @@ impl TensorStencil {
         tangents: &mut [[Vector3; 2]],
     ) {
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
+        #[cfg(target_arch = "x86_64")]
+        if self.order == 4 && simd::available() {
+            // SAFETY: the CPU has AVX and FMA (checked just now).
+            return unsafe { simd::cubic_jets(self, frame, first_row, positions, tangents) };
+        }
         match self.order {
             2 => self.tangent_kernel::<2>(frame, first_row, positions, tangents),
             3 => self.tangent_kernel::<3>(frame, first_row, positions, tangents),
@@ -277,10 +282,107 @@ impl TensorStencil {
             });
     }
 
-    /// One row of [`TensorStencil::tangent_kernel`].
+    /// After the control points `moved` changed: the position and tangents anew of every row with
+    /// a block that uses one of them, handed to `write` with that row's entries of `first` and
+    /// `second` (per-row outputs, such as positions and tangents), on all cores; returns those
+    /// rows, in increasing order.
+    ///
+    /// Which rows those are is read from the blocks themselves: a block uses the order × order
+    /// window of its chart's grid from its first control point, so a table over the grid of the
+    /// windows that hold a moved point answers per block in one look-up. One pass over the blocks'
+    /// first indices (4 bytes a block) replaces a column index's millions of scattered entries, and
+    /// the kernel runs in the same pass. Rows where the moved points' charts were left out as
+    /// negligible ([`NEGLIGIBLE_BLEND`]) are not among them: they move by less than that fraction of
+    /// the points' motion.
+    ///
+    /// # Panics
+    /// If the stencil was built without tangents, or `first` or `second` is shorter than the
+    /// stencil.
+    pub fn update_rows_of_controls<A: Send, B: Send>(
+        &self,
+        control: &[Point3],
+        moved: &[u32],
+        first: &mut [A],
+        second: &mut [B],
+        write: impl Fn(&mut A, &mut B, Point3, [Vector3; 2]) + Sync,
+    ) -> Vec<u32> {
+        assert!(self.has_tangents(), "a tensor stencil built with tangents");
+        match self.order {
+            2 => self.update_rows::<2, A, B>(control, moved, first, second, &write),
+            3 => self.update_rows::<3, A, B>(control, moved, first, second, &write),
+            4 => self.update_rows::<4, A, B>(control, moved, first, second, &write),
+            5 => self.update_rows::<5, A, B>(control, moved, first, second, &write),
+            6 => self.update_rows::<6, A, B>(control, moved, first, second, &write),
+            7 => self.update_rows::<7, A, B>(control, moved, first, second, &write),
+            _ => self.update_rows::<8, A, B>(control, moved, first, second, &write),
+        }
+    }
+
+    fn update_rows<const O: usize, A: Send, B: Send>(
+        &self,
+        control: &[Point3],
+        moved: &[u32],
+        first: &mut [A],
+        second: &mut [B],
+        write: &(impl Fn(&mut A, &mut B, Point3, [Vector3; 2]) + Sync),
+    ) -> Vec<u32> {
+        let windows = self.windows_holding(moved, control.len());
+        let frame = ControlFrame::new(control);
+        let rows = self.rows();
+        let parts: Vec<Vec<u32>> = first[..rows]
+            .par_chunks_mut(ROWS_PER_TASK)
+            .zip(second[..rows].par_chunks_mut(ROWS_PER_TASK))
+            .enumerate()
+            .map(|(k, (first, second))| {
+                let start = k * ROWS_PER_TASK;
+                let mut touched = Vec::new();
+                for (i, (a, b)) in first.iter_mut().zip(second).enumerate() {
+                    let r = start + i;
+                    let blocks = self.row_starts[r] as usize..self.row_starts[r + 1] as usize;
+                    if self.firsts[blocks]
+                        .iter()
+                        .any(|&f| windows[f as usize / 64] & (1 << (f % 64)) != 0)
+                    {
+                        let (p, t) = self.row_jet::<O>(&frame, r);
+                        write(a, b, p, t);
+                        touched.push(r as u32);
+                    }
+                }
+                touched
+            })
+            .collect();
+        parts.concat()
+    }
+
+    /// A bit per control point: set where the order × order window from that point holds one of
+    /// `moved`.
+    fn windows_holding(&self, moved: &[u32], control_count: usize) -> Vec<u64> {
+        let (g, o) = (self.grid, self.order);
+        let mut bits = vec![0u64; control_count.div_ceil(64).max(1)];
+        for &m in moved {
+            let m = m as usize;
+            let (base, local) = (m - m % (g * g), m % (g * g));
+            let (row, column) = (local / g, local % g);
+            for j in 0..o.min(row + 1) {
+                for i in 0..o.min(column + 1) {
+                    let first = base + (row - j) * g + (column - i);
+                    bits[first / 64] |= 1 << (first % 64);
+                }
+            }
+        }
+        bits
+    }
+
+    /// One row of [`TensorStencil::tangent_kernel`] (by the cubic AVX kernel where it runs).
     fn row_jet<const O: usize>(&self, frame: &ControlFrame, r: usize) -> (Point3, [Vector3; 2]) {
         let mut position = [Point3::origin()];
         let mut tangents = [[Vector3::zeros(); 2]];
+        #[cfg(target_arch = "x86_64")]
+        if O == 4 && simd::available() {
+            // SAFETY: the CPU has AVX and FMA (checked just now).
+            unsafe { simd::cubic_jets(self, frame, r, &mut position, &mut tangents) };
+            return (position[0], tangents[0]);
+        }
         self.tangent_kernel::<O>(frame, r, &mut position, &mut tangents);
         (position[0], tangents[0])
     }
@@ -449,6 +551,81 @@ mod simd {
             unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), sum) };
             let [x, y, z, _] = lanes.map(f64::from);
             *o = frame.centre + Vector3::new(x, y, z);
+        }
+    }
+
+    /// Positions and tangents of rows `first_row..first_row + positions.len()` of a cubic stencil
+    /// built with tangents: the portable tangent kernel's sums, two control points per 256-bit
+    /// register. Every step after the first products is linear with the same factor in both
+    /// halves, so the halves are added only at the row's end.
+    #[target_feature(enable = "avx,fma")]
+    pub(super) fn cubic_jets(
+        stencil: &TensorStencil,
+        frame: &ControlFrame,
+        first_row: usize,
+        positions: &mut [Point3],
+        tangents: &mut [[Vector3; 2]],
+    ) {
+        if positions.is_empty() {
+            return;
+        }
+        let pair = |a: f32, b: f32| _mm256_set_m128(_mm_set1_ps(b), _mm_set1_ps(a));
+        let starts = &stencil.row_starts[first_row..=first_row + positions.len()];
+        for ((o, t), span) in positions.iter_mut().zip(tangents).zip(starts.windows(2)) {
+            let (mut p, mut su, mut sv) = (
+                _mm256_setzero_ps(),
+                _mm256_setzero_ps(),
+                _mm256_setzero_ps(),
+            );
+            for k in span[0] as usize..span[1] as usize {
+                let f: &[f32; 8] = stencil.factors[8 * k..8 * k + 8]
+                    .try_into()
+                    .expect("cubic factors");
+                let d: &[f32; 12] = stencil.tangent_factors[12 * k..12 * k + 12]
+                    .try_into()
+                    .expect("cubic tangent factors");
+                let (u01, u23) = (pair(f[0], f[1]), pair(f[2], f[3]));
+                let (du01, du23) = (pair(d[0], d[1]), pair(d[2], d[3]));
+                let first = stencil.firsts[k] as usize;
+                let (mut a, mut b, mut c) = (
+                    _mm256_setzero_ps(),
+                    _mm256_setzero_ps(),
+                    _mm256_setzero_ps(),
+                );
+                for j in 0..4 {
+                    let start = first + j * stencil.grid;
+                    let line = &frame.points[start..start + 4];
+                    let ptr = line.as_ptr().cast::<f32>();
+                    // SAFETY: `line` is 4 Vec4s, 16 contiguous f32; the loads read floats 0–7 and
+                    // 8–15 of it.
+                    let (c01, c23) = unsafe { (_mm256_loadu_ps(ptr), _mm256_loadu_ps(ptr.add(8))) };
+                    let s = _mm256_fmadd_ps(c23, u23, _mm256_mul_ps(c01, u01));
+                    let s1 = _mm256_fmadd_ps(c23, du23, _mm256_mul_ps(c01, du01));
+                    let (v, dv) = (_mm256_set1_ps(f[4 + j]), _mm256_set1_ps(d[4 + j]));
+                    a = _mm256_fmadd_ps(s, v, a);
+                    b = _mm256_fmadd_ps(s1, v, b);
+                    c = _mm256_fmadd_ps(s, dv, c);
+                }
+                let (gu, gv) = (_mm256_set1_ps(d[8]), _mm256_set1_ps(d[9]));
+                let (re, im) = (_mm256_set1_ps(d[10]), _mm256_set1_ps(d[11]));
+                p = _mm256_add_ps(p, a);
+                su = _mm256_fmadd_ps(a, gu, su);
+                su = _mm256_fmadd_ps(b, re, su);
+                su = _mm256_fmadd_ps(c, im, su);
+                sv = _mm256_fmadd_ps(a, gv, sv);
+                sv = _mm256_fnmadd_ps(b, im, sv);
+                sv = _mm256_fmadd_ps(c, re, sv);
+            }
+            let wide = |v: __m256| {
+                let sum = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+                let mut lanes = [0f32; 4];
+                // SAFETY: `lanes` holds the 4 floats stored.
+                unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), sum) };
+                let [x, y, z, _] = lanes.map(f64::from);
+                Vector3::new(x, y, z)
+            };
+            *o = frame.centre + wide(p);
+            *t = [wide(su), wide(sv)];
         }
     }
 }
