@@ -1300,35 +1300,39 @@ pub(crate) fn smoothness_rows(layout: &Layout) -> Vec<Vec<(usize, f64)>> {
     let g = layout.settings().grid;
     let mut rows = Vec::new();
     for chart in layout.atlas().charts() {
-        let id: ChartId = chart.id();
-        let at = |i: usize, j: usize| layout.control_index(id, i, j);
         for j in 0..g {
             for i in 0..g {
-                if i + 2 < g {
-                    rows.push(vec![
-                        (at(i, j), 1.0),
-                        (at(i + 1, j), -2.0),
-                        (at(i + 2, j), 1.0),
-                    ]);
-                }
-                if j + 2 < g {
-                    rows.push(vec![
-                        (at(i, j), 1.0),
-                        (at(i, j + 1), -2.0),
-                        (at(i, j + 2), 1.0),
-                    ]);
-                }
-                if i + 1 < g && j + 1 < g {
-                    let s = std::f64::consts::SQRT_2;
-                    rows.push(vec![
-                        (at(i, j), s),
-                        (at(i + 1, j), -s),
-                        (at(i, j + 1), -s),
-                        (at(i + 1, j + 1), s),
-                    ]);
-                }
+                smoothness_rows_at(layout, chart.id(), i, j, |row| rows.push(row.to_vec()));
             }
         }
     }
     rows
+}
+
+/// The rows of [`smoothness_rows`] whose first control point is (i, j) of `chart`'s grid: none to
+/// three, each handed to `row`.
+pub(crate) fn smoothness_rows_at(
+    layout: &Layout,
+    chart: ChartId,
+    i: usize,
+    j: usize,
+    mut row: impl FnMut(&[(usize, f64)]),
+) {
+    let g = layout.settings().grid;
+    let at = |i: usize, j: usize| layout.control_index(chart, i, j);
+    if i + 2 < g {
+        row(&[(at(i, j), 1.0), (at(i + 1, j), -2.0), (at(i + 2, j), 1.0)]);
+    }
+    if j + 2 < g {
+        row(&[(at(i, j), 1.0), (at(i, j + 1), -2.0), (at(i, j + 2), 1.0)]);
+    }
+    if i + 1 < g && j + 1 < g {
+        let s = std::f64::consts::SQRT_2;
+        row(&[
+            (at(i, j), s),
+            (at(i + 1, j), -s),
+            (at(i, j + 1), -s),
+            (at(i + 1, j + 1), s),
+        ]);
+    }
 }

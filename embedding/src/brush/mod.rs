@@ -521,6 +521,17 @@ impl Reach {
             entries: Vec::new(),
             controls: Vec::new(),
         };
+        // Room for every sample's rows at once (a row and its patches hold at most twice a stencil
+        // row's entries): growing by doubling copied megabytes per dab. Pages never written cost
+        // nothing.
+        let widest = reach
+            .samples
+            .iter()
+            .map(|&r| stencil.row(r as usize).len())
+            .max()
+            .unwrap_or(0);
+        reach.entries.reserve(2 * widest * reach.samples.len());
+        reach.rows.reserve(4 * reach.samples.len());
         // Each chart's own patch is fitted too, weighted by its blend (as the initial fit does):
         // the blend alone leaves the patches free to disagree in the overlaps, and they would
         // ripple. A stencil row's entries of chart i are β_i N_c (uniform B-splines sum to 1), so
@@ -624,17 +635,37 @@ impl Reach {
             }
             sum
         };
-        let mut entries = Vec::new();
-        for row in crate::fit::smoothness_rows(layout) {
-            entries.clear();
-            entries.extend(
-                row.iter()
-                    .filter_map(|&(c, w)| Some((column(c as u32)?, w))),
-            );
-            if !entries.is_empty() {
-                system.add(&entries, fairness);
-                each_fairness_row(&entries, &row);
+        // Only the rows near the moving control points can touch them: those whose first point
+        // lies up to two steps before one of them along each grid direction, each taken once.
+        let g = layout.settings().grid;
+        let mut origins = vec![0u64; layout.control_count().div_ceil(64)];
+        for &c in &self.controls {
+            let (c, per_chart) = (c as usize, g * g);
+            let (base, local) = (c - c % per_chart, c % per_chart);
+            let (j, i) = (local / g, local % g);
+            for dj in 0..=j.min(2) {
+                for di in 0..=i.min(2) {
+                    let o = base + (j - dj) * g + (i - di);
+                    origins[o / 64] |= 1 << (o % 64);
+                }
             }
+        }
+        let mut entries = Vec::new();
+        for o in set_bits(&origins) {
+            let (o, per_chart) = (o as usize, g * g);
+            let chart = charts::ChartId((o / per_chart) as u32);
+            let (j, i) = ((o % per_chart) / g, o % g);
+            crate::fit::smoothness_rows_at(layout, chart, i, j, |row| {
+                entries.clear();
+                entries.extend(
+                    row.iter()
+                        .filter_map(|&(c, w)| Some((column(c as u32)?, w))),
+                );
+                if !entries.is_empty() {
+                    system.add(&entries, fairness);
+                    each_fairness_row(&entries, row);
+                }
+            });
         }
         system
     }

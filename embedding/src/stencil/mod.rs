@@ -102,7 +102,7 @@ impl Stencil {
 
     /// Row r's weights: each control point it uses with its weight and the weight's u and v
     /// derivatives.
-    pub fn row(&self, r: usize) -> impl Iterator<Item = (u32, [f64; 3])> + '_ {
+    pub fn row(&self, r: usize) -> impl ExactSizeIterator<Item = (u32, [f64; 3])> + '_ {
         (self.offsets[r]..self.offsets[r + 1])
             .map(move |k| (self.controls[k], [self.pos[k], self.du[k], self.dv[k]]))
     }
