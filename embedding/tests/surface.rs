@@ -732,7 +732,7 @@ proptest! {
         // evaluation's very numbers), and every other row stays, where the f64 stencil says it
         // moves by no more than the tensor stencil's own error.
         let moved: Vec<u32> = (0..layout.control_count() as u32)
-            .filter(|c| (c ^ seed as u32) % 7 == 0)
+            .filter(|c| (c ^ seed as u32).is_multiple_of(7))
             .collect();
         let mut after = control.clone();
         for &c in &moved {

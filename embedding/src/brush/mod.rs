@@ -4,27 +4,31 @@
 //! A grab brush moves each surface point x by Δ · f(|x − c| / R): the falloff f of its distance from
 //! the brush's centre c, in model space. That field is not a spline, so the brush moves the control
 //! points by the least-squares spline nearest to it: per control point a share β_c of Δ (the field
-//! is linear in Δ, so the shares are computed once per press), fitted over the tessellation's
-//! vertices that the moving control points reach (about 32 per moving control point, chosen by a
-//! hash of the position's |x|, |y|, |z| so that mirror images are chosen alike), each weighted by
-//! its area, so that dense and sparse parts of the tessellation count
-//! alike. The unknowns are few (one per moving control point), so the normal equations are
-//! formed and solved by a dense Cholesky factorization. Vertices beyond the radius that those control
-//! points reach are in the fit with target 0, which keeps the edit inside the brush. The dragged
-//! point and the pins are then made exact by the minimum-norm correction of [`crate::edit`].
+//! is linear in Δ, so the shares are computed once per press), fitted over the surface's brush
+//! samples ([`SurfaceSamples`]: a tessellation of its own, about 4 vertices per control point,
+//! whatever the viewer shows) that the moving control points reach, each weighted by its area, so
+//! that dense and sparse parts of the tessellation count alike. The moving control points are those
+//! with a weight of at least 1e-3 at some sample inside the disc; the others' influence lies
+//! outside it. The unknowns are few (one per moving control point), so the normal equations are
+//! formed and solved by a dense Cholesky factorization. Samples beyond the radius that those
+//! control points reach are in the fit with target 0, which keeps the edit inside the brush. The
+//! dragged point and the pins are then made exact by the minimum-norm correction of
+//! [`crate::edit`].
 //!
 //! The fit has two more kinds of rows, as the initial fit does: each chart's own patch is fitted to
 //! the field as well, weighted by its blend (else patches disagree in the overlaps and ripple), and
 //! the second differences of the shares over each chart's grid are kept small (fairness, so a steep
 //! profile such as a dome's rim does not ring). What a spline of the model's grid can show sets a
-//! floor on the radius: on a genus-2 plate at grid 16 (the default grid until it became 32)
-//! footprints match the falloff from about 0.2 of the model's size in every chart, and from 0.12 in
-//! the edge charts; below that the bump comes out wider and lower, and the correction still takes
-//! the dragged point to its target.
+//! floor on the radius: on the genus-2 plate at grid 32 footprints match the falloff from 0.12 of
+//! the model's size in every chart (at grid 16 only from 0.2, and from 0.12 in the edge charts);
+//! below that the bump comes out wider and lower, and the correction still takes the dragged point
+//! to its target.
 //!
 //! Because the fit sees only model-space distances and surface samples, the same brush at the
 //! same surface point gives the same shares whichever chart the point was picked in, and footprints
-//! of the same width in every chart.
+//! of the same width in every chart; and because the samples are the surface's, not the view's,
+//! the same edit at any display resolution, mirror-symmetric on a symmetric surface whether or not
+//! the view's tessellation is.
 //!
 //! The stroke brushes ([`dab`]) use the same least-squares problem (`Reach`) with other fields:
 //! inflate along the outward normal, flatten towards a plane; smooth is an implicit fairing step
