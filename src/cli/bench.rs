@@ -240,6 +240,16 @@ pub fn measure(
         "vertices",
         bytes,
     );
+    // The same without the cubic AVX/FMA kernel (where it runs), for the ratio between the two.
+    let secs = best_of(5, || {
+        framed.positions_and_tangents_portable(black_box(&control), &mut out, &mut tangents)
+    });
+    add(
+        "reembed_tangents_portable",
+        pts.len() as f64 / secs,
+        "vertices",
+        bytes,
+    );
     let secs = best_of(5, || {
         framed.positions_and_tangents_parallel(black_box(&control), &mut out, &mut tangents)
     });

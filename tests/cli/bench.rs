@@ -23,6 +23,7 @@ fn bench_prints_json_figures() {
             "reembed_full_f64",
             "stencil_build_tangents",
             "reembed_tangents",
+            "reembed_tangents_portable",
             "reembed_tangents_all_cores",
             "reembed_tangents_full_f64",
             "drag_event"
@@ -36,7 +37,7 @@ fn bench_prints_json_figures() {
         let rate = f["per_second"].as_f64().unwrap();
         assert!(rate.is_finite() && rate > 0.0, "{f}");
     }
-    for f in figures[4..7].iter().chain(&figures[8..11]) {
+    for f in figures[4..7].iter().chain(&figures[8..12]) {
         let fraction = f["fraction_of_copy_bandwidth"].as_f64().unwrap();
         assert!(
             fraction > 0.0 && fraction < 5.0,

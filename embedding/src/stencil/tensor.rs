@@ -211,6 +211,30 @@ impl TensorStencil {
         self.frames_into(&frame, 0, &mut positions[..rows], &mut tangents[..rows]);
     }
 
+    /// [`TensorStencil::positions_and_tangents`] by the portable kernel alone, even where the cubic
+    /// one with AVX and FMA would run: for tests and benches that compare the two.
+    #[doc(hidden)]
+    pub fn positions_and_tangents_portable(
+        &self,
+        control: &[Point3],
+        positions: &mut [Point3],
+        tangents: &mut [[Vector3; 2]],
+    ) {
+        assert!(self.has_tangents(), "a tensor stencil built with tangents");
+        let frame = ControlFrame::new(control);
+        let rows = self.rows();
+        let (positions, tangents) = (&mut positions[..rows], &mut tangents[..rows]);
+        match self.order {
+            2 => self.tangent_kernel::<2>(&frame, 0, positions, tangents),
+            3 => self.tangent_kernel::<3>(&frame, 0, positions, tangents),
+            4 => self.tangent_kernel::<4>(&frame, 0, positions, tangents),
+            5 => self.tangent_kernel::<5>(&frame, 0, positions, tangents),
+            6 => self.tangent_kernel::<6>(&frame, 0, positions, tangents),
+            7 => self.tangent_kernel::<7>(&frame, 0, positions, tangents),
+            _ => self.tangent_kernel::<8>(&frame, 0, positions, tangents),
+        }
+    }
+
     /// [`TensorStencil::positions_and_tangents`] on all cores (the same numbers).
     pub fn positions_and_tangents_parallel(
         &self,
