@@ -147,7 +147,9 @@ fn drag(c: &mut Criterion) {
             b.iter(|| state.drag_to_target(black_box(target())).unwrap())
         });
         state.cancel_drag();
-        stroke_steps(&mut group, &mut state, point, n);
+        // The drags above left their releases in the surface: strokes start from the model.
+        let (mut fresh, point) = setup(&model, t);
+        stroke_steps(&mut group, &mut fresh, point, n);
         state.influence = 0.0;
         group.bench_function(BenchmarkId::new("frame_prepare_full", n), |b| {
             let mut staging: Vec<u8> = Vec::new();

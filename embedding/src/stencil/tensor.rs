@@ -223,16 +223,7 @@ impl TensorStencil {
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
         let frame = ControlFrame::new(control);
         let rows = self.rows();
-        let (positions, tangents) = (&mut positions[..rows], &mut tangents[..rows]);
-        match self.order {
-            2 => self.tangent_kernel::<2>(&frame, 0, positions, tangents),
-            3 => self.tangent_kernel::<3>(&frame, 0, positions, tangents),
-            4 => self.tangent_kernel::<4>(&frame, 0, positions, tangents),
-            5 => self.tangent_kernel::<5>(&frame, 0, positions, tangents),
-            6 => self.tangent_kernel::<6>(&frame, 0, positions, tangents),
-            7 => self.tangent_kernel::<7>(&frame, 0, positions, tangents),
-            _ => self.tangent_kernel::<8>(&frame, 0, positions, tangents),
-        }
+        self.portable_frames_into(&frame, 0, &mut positions[..rows], &mut tangents[..rows]);
     }
 
     /// [`TensorStencil::positions_and_tangents`] on all cores (the same numbers).
@@ -264,6 +255,17 @@ impl TensorStencil {
             // SAFETY: the CPU has AVX and FMA (checked just now).
             return unsafe { simd::cubic_jets(self, frame, first_row, positions, tangents) };
         }
+        self.portable_frames_into(frame, first_row, positions, tangents);
+    }
+
+    /// [`TensorStencil::frames_into`] by the portable kernel.
+    fn portable_frames_into(
+        &self,
+        frame: &ControlFrame,
+        first_row: usize,
+        positions: &mut [Point3],
+        tangents: &mut [[Vector3; 2]],
+    ) {
         match self.order {
             2 => self.tangent_kernel::<2>(frame, first_row, positions, tangents),
             3 => self.tangent_kernel::<3>(frame, first_row, positions, tangents),
