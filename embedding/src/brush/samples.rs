@@ -21,8 +21,8 @@ use super::{BrushSamples, outward};
 
 /// Sample vertices per control point of the whole surface. A dab reaches a quarter to a half of
 /// the surface through its control points' supports, so this gives its fit 16 to 32 samples per
-/// moving control point: as many as the viewer's own vertices gave at 10⁵ (where footprints and
-/// each brush's effect were measured), and the fit stays well determined.
+/// moving control point, about as many as the viewer's own vertices gave at 10⁵ (where footprints
+/// and each brush's effect had been measured), and the fit stays well determined.
 pub const SAMPLES_PER_CONTROL_POINT: usize = 4;
 
 /// A surface's brush samples: their chart points and triangles, their stencil and its column
