@@ -1324,8 +1324,9 @@ fn asymmetry(state: &EditorState, centre: Point3, radius: f64, signs: Vector3) -
 /// Σ H² dA over the vertices within `radius` of `centre`: the bending energy there.
 fn bending_energy(state: &mut EditorState, centre: Point3, radius: f64) -> f64 {
     let surface = state.surface().clone();
-    state.mesh_mut().refresh_brush_weights(&surface).unwrap();
-    let samples = state.mesh().brush_samples(state.surface());
+    let mesh = state.mesh_mut();
+    mesh.refresh_brush_weights(&surface).unwrap();
+    let samples = mesh.brush_samples(&surface).unwrap();
     (0..samples.positions.len())
         .filter(|&r| (samples.positions[r] - centre).norm() < radius)
         .map(|r| {
@@ -1360,6 +1361,64 @@ fn distance_from_plane(state: &EditorState, centre: Point3, radius: f64, facing:
             a + b
         });
     (scatter.symmetric_eigen().eigenvalues.min() / total).sqrt()
+}
+
+/// During a stroke the viewport's vertices lag the surface by less than `UNSEEN` of the model's
+/// size (a control point's vertices are re-evaluated once it has moved that far), also after an
+/// undo and a switch of style in between, and the stroke's end makes them exact again.
+#[test]
+fn a_stroke_keeps_its_vertices_within_a_tenth_of_a_pixel() {
+    use embedding::brush::BrushKind;
+    use ntori::editor::mesh::UNSEEN;
+    use ntori::render::{CurvatureKind, Style};
+    let mut state = brush_state();
+    let size = state.size();
+    let point = top_point(&state, 0.3 * size);
+    let at = state.surface_point(point);
+    state.influence = 0.15;
+    let radius = state.radius();
+    // The largest distance between a vertex as shown and where the control points put it.
+    let lag = |state: &EditorState| {
+        let mesh = state.mesh();
+        (0..mesh.vertex_count())
+            .map(|r| (mesh.stencil().position(state.control(), r) - mesh.positions()[r]).norm())
+            .fold(0.0, f64::max)
+    };
+    let mut lagged = 0.0f64;
+    for (round, kind) in [BrushKind::Inflate, BrushKind::Smooth]
+        .into_iter()
+        .enumerate()
+    {
+        state.brush = kind;
+        state.strength = 0.3;
+        state.start_stroke(point).unwrap();
+        for k in 1..=6 {
+            let next = state.nearest_vertex(at + Vector3::new(0.0, 0.3 * radius * k as f64, 0.0));
+            state.stroke_at(next).unwrap();
+            let now = lag(&state);
+            lagged = lagged.max(now);
+            assert!(
+                now <= UNSEEN * size * (1.0 + 1e-6) + 1e-6 * size,
+                "{kind:?}, dab {k}: a vertex lags by {:e} of the size",
+                now / size
+            );
+        }
+        state.release();
+        assert!(lag(&state) <= 1e-12 * size, "exact after the stroke");
+        if round == 0 {
+            state.undo().unwrap();
+            state.set_style(Style::Curvature(CurvatureKind::Mean));
+            state.set_style(Style::Shaded);
+        }
+    }
+    println!(
+        "the largest lag during the strokes: {:e} of the size",
+        lagged / size
+    );
+    assert!(
+        lagged > 0.0,
+        "some vertices were left for later (else the test shows nothing)"
+    );
 }
 
 /// Each brush changes the surface as it says, inside its radius only, and a stroke of several dabs

@@ -138,7 +138,7 @@ impl DragPlan {
                     std::iter::once((start_position, Vector3::new(1.0, 1.0, 1.0)))
                         .chain(images.iter().map(|&(_, at, signs)| (at, signs)))
                         .collect();
-                grab_shares_mirrored(&mesh.brush_samples(surface), &centres, radius, falloff)?
+                grab_shares_mirrored(&mesh.brush_samples(surface)?, &centres, radius, falloff)?
             }
             _ => Vec::new(),
         };

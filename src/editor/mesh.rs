@@ -1,6 +1,7 @@
 //! The surface as the viewport shows it: the tessellation, its stencil, every vertex's exact position
-//! and tangents (f64), the vertices as the GPU reads them (f32, indexed), which of them changed since
-//! the last upload, and the picking hierarchy.
+//! and tangents (f64; during a stroke, positions within [`UNSEEN`] of the model's size and tangents
+//! as of the stroke's start, until its end), the vertices as the GPU reads them (f32, indexed), which
+//! of them changed since the last upload, the picking hierarchy, and the surface's brush samples.
 //!
 //! Vertices are shared between triangles (an index buffer), so an edit rewrites each moved vertex
 //! once; the GPU pulls them by index (see `gpu.rs`), so the wireframe still gets per-corner
@@ -14,8 +15,8 @@ use embedding::brush::{BrushSamples, SurfaceSamples};
 use embedding::remesh::{QualitySettings, quality_mesh};
 use embedding::stencil::TensorStencil;
 use embedding::{
-    ColumnIndex, ControlId, Point3, Sample, Stencil, Surface, Vector3, Wants, bounding_box,
-    evaluate_rows,
+    ColumnIndex, ControlId, EmbeddingError, Point3, Sample, Stencil, Surface, Vector3, Wants,
+    bounding_box, evaluate_rows,
 };
 
 use num_complex::Complex64;
@@ -158,7 +159,8 @@ pub struct LiveMesh {
     /// The surface points brushes are fitted over (not these vertices: see
     /// [`embedding::brush::SurfaceSamples`]), as of the last [`LiveMesh::refresh_brush_weights`]
     /// and the dabs since.
-    samples: SurfaceSamples,
+    /// Made at the first brush's start (a model that is never brushed needs none).
+    samples: Option<SurfaceSamples>,
     size: f64,
     /// Per control point, how far it has moved (summed) since the vertices it reaches were last
     /// re-evaluated: see [`LiveMesh::controls_moved`].
@@ -194,7 +196,7 @@ impl LiveMesh {
             bvh_stale: true,
             style,
             curvature_range: None,
-            samples: SurfaceSamples::new(surface)?,
+            samples: None,
             size: 0.0,
             pending: Vec::new(),
             tensor: None,
@@ -211,10 +213,9 @@ impl LiveMesh {
     /// samples after a change of spline settings) and the model's size up to the vertices: at a
     /// drag's or stroke's start, for edits, undo and refits may have happened since.
     pub fn refresh_brush_weights(&mut self, surface: &Surface) -> Result<(), EditorError> {
-        if self.samples.fits(surface) {
-            self.samples.refresh(surface);
-        } else {
-            self.samples = SurfaceSamples::new(surface)?;
+        match &mut self.samples {
+            Some(samples) if samples.fits(surface) => samples.refresh(surface),
+            _ => self.samples = Some(SurfaceSamples::new(surface)?),
         }
         self.refresh_size();
         Ok(())
@@ -225,9 +226,20 @@ impl LiveMesh {
         self.size = (hi - lo).norm();
     }
 
-    /// The surface as a brush samples it.
-    pub fn brush_samples<'a>(&'a self, surface: &'a Surface) -> BrushSamples<'a> {
-        self.samples.view(surface)
+    /// The surface as a brush samples it (as of the last [`LiveMesh::refresh_brush_weights`] and
+    /// the dabs since; made now if there are no samples for `surface` yet).
+    pub fn brush_samples<'a>(
+        &'a mut self,
+        surface: &'a Surface,
+    ) -> Result<BrushSamples<'a>, EmbeddingError> {
+        if !self.samples.as_ref().is_some_and(|s| s.fits(surface)) {
+            self.samples = None;
+        }
+        let samples = match self.samples.take() {
+            Some(samples) => samples,
+            None => SurfaceSamples::new(surface)?,
+        };
+        Ok(self.samples.insert(samples).view(surface))
     }
 
     pub fn stencil(&self) -> &Stencil {
@@ -236,7 +248,8 @@ impl LiveMesh {
     pub fn columns(&self) -> &ColumnIndex {
         &self.columns
     }
-    /// Exact positions (stencil × control points) of every vertex.
+    /// Exact positions (stencil × control points) of every vertex (during a stroke: within
+    /// [`UNSEEN`] of the model's size).
     pub fn positions(&self) -> &[Point3] {
         &self.positions
     }
@@ -360,8 +373,8 @@ impl LiveMesh {
     }
 
     /// After a brush's dab moved control points (each with how far): the brush samples they reach
-    /// exactly, and the vertices through the f32 tensor stencil (to about 1e-7 of the model's size;
-    /// made at the first call), on all cores; call [`LiveMesh::controls_changed`] with every
+    /// exactly, and the vertices through the f32 tensor stencil (made at the first call; within
+    /// [`UNSEEN`] of the model's size, below), on all cores; call [`LiveMesh::controls_changed`] with every
     /// control point a stroke moved when it ends, to make the vertices exact. In the shaded and
     /// wireframe styles that is all a vertex shows; in the others the colours follow too (the
     /// exact, full evaluation).
@@ -374,7 +387,9 @@ impl LiveMesh {
     /// motion so far along too).
     pub fn controls_moved(&mut self, surface: &Surface, moved: &[(ControlId, Vector3)]) {
         let controls: Vec<ControlId> = moved.iter().map(|m| m.0).collect();
-        self.samples.controls_moved(surface, &controls);
+        if let Some(samples) = &mut self.samples {
+            samples.controls_moved(surface, &controls);
+        }
         if matches!(self.style, Style::Curvature(_) | Style::Charts) {
             self.controls_changed(surface, &controls);
             return;

@@ -710,6 +710,9 @@ impl EditorState {
         settings: SplineSettings,
         control: Vec<Point3>,
     ) -> Result<(), EditorError> {
+        // A drag or stroke in progress (a refit can finish during one) ends first, as if released:
+        // its control points are the old settings'.
+        self.release();
         let before = (self.settings(), self.control().to_vec());
         self.replace_control(settings, control.clone())?;
         self.history.push(

@@ -59,7 +59,7 @@ impl Stroke {
         centres: &[(Point3, Vector3)],
     ) -> Result<usize, EmbeddingError> {
         let started = Instant::now();
-        let moved = dab(&mesh.brush_samples(surface), self.brush, centres)?;
+        let moved = dab(&mesh.brush_samples(surface)?, self.brush, centres)?;
         let control = surface.control_points();
         let updates: Vec<(ControlId, Point3)> = moved
             .iter()

@@ -5,8 +5,8 @@
 //! the brush's centre c, in model space. That field is not a spline, so the brush moves the control
 //! points by the least-squares spline nearest to it: per control point a share β_c of Δ (the field
 //! is linear in Δ, so the shares are computed once per press), fitted over the surface's brush
-//! samples ([`SurfaceSamples`]: a tessellation of its own, about 4 vertices per control point,
-//! whatever the viewer shows) that the moving control points reach, each weighted by its area, so
+//! samples ([`SurfaceSamples`]: a tessellation of its own, about 4 vertices per control point and
+//! 25 000 at least, whatever the viewer shows) that the moving control points reach, each weighted by its area, so
 //! that dense and sparse parts of the tessellation count alike. The moving control points are those
 //! with a weight of at least 1e-3 at some sample inside the disc; the others' influence lies
 //! outside it. The unknowns are few (one per moving control point), so the normal equations are
@@ -37,7 +37,7 @@
 
 mod samples;
 
-pub use samples::{SAMPLES_PER_CONTROL_POINT, SurfaceSamples};
+pub use samples::{MIN_SAMPLES, SAMPLES_PER_CONTROL_POINT, SurfaceSamples};
 
 use charts::ChartPoint;
 use faer::linalg::solvers::Solve;
@@ -203,7 +203,7 @@ pub fn outward(positions: &[Point3], tangents: &[[Vector3; 2]], areas: &[f64]) -
 
 /// A grab brush of `radius` (model units) centred at `centre` with profile `falloff`: each control
 /// point that moves, with its share β of the displacement (sorted by control point). Empty when no
-/// vertex lies within the radius.
+/// sample lies within the radius.
 pub fn grab_shares(
     samples: &BrushSamples,
     centre: Point3,
@@ -441,15 +441,15 @@ pub fn nearest_on_surface(
 }
 
 /// The least-squares problem of a brush at some centres: the control points that reach the
-/// brush's discs, the vertices they reach (sampled) and the rows of the normal equations over them.
+/// brush's discs, the samples they reach (thinned) and the rows of the normal equations over them.
 /// They depend on where the brush is, not on the field it fits, so one factorization serves the
 /// three coordinates of a displacement (or a scalar share).
 struct Reach {
     /// The moving control points, sorted.
     controls: Vec<u32>,
-    /// The vertices the fit samples (each with its rows below).
+    /// The samples the fit uses (each with its rows below).
     samples: Vec<u32>,
-    /// The vertices within the radius of some centre.
+    /// The samples within the radius of some centre.
     inside: Vec<u32>,
     /// The data rows: the sample they belong to (index into `samples`), their weight and their
     /// entries' range in `entries` (column in `controls`, weight).
@@ -496,11 +496,11 @@ impl Reach {
             return Ok(None);
         }
         let reached = stencil.rows_of_controls(columns, controls.iter().map(|&c| c as usize));
-        // A fine tessellation has far more vertices than the spline has freedom: one in k of them
-        // (about SAMPLES_PER_CONTROL per moving control point) fits the same field, each standing
-        // for k vertices' area, and the press stays quick at 10⁶ vertices. Which ones is decided
-        // by a hash of |x|, |y|, |z|, not by index: mirror images on a symmetric tessellation are
-        // both taken or both left, so a symmetric stroke stays symmetric.
+        // Where the samples reached are many more than the spline has freedom there, one in k of
+        // them (about SAMPLES_PER_CONTROL per moving control point) fits the same field, each
+        // standing for k samples' area. Which ones is decided by a hash of |x|, |y|, |z|, not by
+        // index: mirror images on a symmetric tessellation are both taken or both left, so a
+        // symmetric stroke stays symmetric.
         let stride = reached
             .len()
             .div_ceil(SAMPLES_PER_CONTROL * controls.len())

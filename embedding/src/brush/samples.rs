@@ -25,6 +25,12 @@ use super::{BrushSamples, outward};
 /// and each brush's effect had been measured), and the fit stays well determined.
 pub const SAMPLES_PER_CONTROL_POINT: usize = 4;
 
+/// At least this many samples, whatever the grid: a disc of the editor's smallest radius (1% of the
+/// model's size) then still holds several on a plate or a sphere (whose area is about the square of
+/// its diagonal), where a coarse grid's 4 per control point would leave it empty and the brush
+/// would do nothing.
+pub const MIN_SAMPLES: usize = 25_000;
+
 /// A surface's brush samples: their chart points and triangles, their stencil and its column
 /// index, and as of the last [`SurfaceSamples::refresh`] (or [`SurfaceSamples::controls_moved`])
 /// their exact positions and tangents, their areas and the normals' orientation.
@@ -128,9 +134,10 @@ impl SurfaceSamples {
 }
 
 /// The smallest t_e = t_r whose tessellation has [`SAMPLES_PER_CONTROL_POINT`] vertices per control
-/// point (a closed triangle mesh has about half as many vertices as triangles).
+/// point, and [`MIN_SAMPLES`] at least (a closed triangle mesh has about half as many vertices as
+/// triangles).
 fn resolution(genus: u32, control_count: usize) -> u32 {
-    let wanted = 2 * (SAMPLES_PER_CONTROL_POINT * control_count) as u64;
+    let wanted = 2 * (SAMPLES_PER_CONTROL_POINT * control_count).max(MIN_SAMPLES) as u64;
     (4..MAX_RESOLUTION)
         .find(|&t| Tessellation::expected_triangles(genus, t, t) >= wanted)
         .unwrap_or(MAX_RESOLUTION)
