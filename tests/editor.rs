@@ -1323,18 +1323,17 @@ fn asymmetry(state: &EditorState, centre: Point3, radius: f64, signs: Vector3) -
 
 /// Σ H² dA over the vertices within `radius` of `centre`: the bending energy there.
 fn bending_energy(state: &mut EditorState, centre: Point3, radius: f64) -> f64 {
-    let surface = state.surface().clone();
-    let mesh = state.mesh_mut();
-    mesh.refresh_brush_weights(&surface).unwrap();
-    let samples = mesh.brush_samples(&surface).unwrap();
-    (0..samples.positions.len())
-        .filter(|&r| (samples.positions[r] - centre).norm() < radius)
+    // Over the viewport's vertices, not the brush's own samples: a measure the brush does not fit.
+    let mesh = state.mesh();
+    let areas = embedding::fit::vertex_areas(mesh.positions(), &mesh.tessellation.triangles);
+    let layout = state.layout();
+    (0..mesh.vertex_count())
+        .filter(|&r| (mesh.positions()[r] - centre).norm() < radius)
         .map(|r| {
-            let h = samples
-                .layout
-                .eval(samples.control, samples.points[r])
+            let h = layout
+                .eval(state.control(), mesh.tessellation.vertices[r])
                 .mean_curvature();
-            h * h * samples.areas[r]
+            h * h * areas[r]
         })
         .sum()
 }
