@@ -232,12 +232,9 @@ impl LiveMesh {
         &'a mut self,
         surface: &'a Surface,
     ) -> Result<BrushSamples<'a>, EmbeddingError> {
-        if !self.samples.as_ref().is_some_and(|s| s.fits(surface)) {
-            self.samples = None;
-        }
         let samples = match self.samples.take() {
-            Some(samples) => samples,
-            None => SurfaceSamples::new(surface)?,
+            Some(samples) if samples.fits(surface) => samples,
+            _ => SurfaceSamples::new(surface)?,
         };
         Ok(self.samples.insert(samples).view(surface))
     }

@@ -46,7 +46,7 @@ use num_complex::Complex64;
 
 use crate::EmbeddingError;
 use crate::spline_surface::ControlId;
-use crate::stencil::{ColumnIndex, Stencil, set_bits};
+use crate::stencil::{ColumnIndex, Stencil, mark_windows_holding, set_bits};
 use crate::surface::{Layout, Point3, Vector3};
 
 /// Weight of the patch terms against the blended surface's (the initial fit's default).
@@ -644,15 +644,7 @@ impl Reach {
         let g = layout.settings().grid;
         let mut origins = vec![0u64; layout.control_count().div_ceil(64)];
         for &c in &self.controls {
-            let (c, per_chart) = (c as usize, g * g);
-            let (base, local) = (c - c % per_chart, c % per_chart);
-            let (j, i) = (local / g, local % g);
-            for dj in 0..=j.min(2) {
-                for di in 0..=i.min(2) {
-                    let o = base + (j - dj) * g + (i - di);
-                    origins[o / 64] |= 1 << (o % 64);
-                }
-            }
+            mark_windows_holding(&mut origins, c as usize, g, 3);
         }
         let mut entries = Vec::new();
         for o in set_bits(&origins) {

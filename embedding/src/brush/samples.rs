@@ -83,12 +83,7 @@ impl SurfaceSamples {
 
     /// Every sample's position, tangents and area, and the normals' orientation, anew.
     pub fn refresh(&mut self, surface: &Surface) {
-        let control = surface.control_points();
-        for r in 0..self.stencil.rows() {
-            let (p, t) = self.stencil.position_and_tangents(control, r);
-            self.positions[r] = p;
-            self.tangents[r] = t;
-        }
+        self.evaluate(surface.control_points(), 0..self.stencil.rows());
         self.areas = crate::fit::vertex_areas(&self.positions, &self.triangles);
         self.outward = outward(&self.positions, &self.tangents, &self.areas);
     }
@@ -97,14 +92,19 @@ impl SurfaceSamples {
     /// areas and orientation stay as they were at the last refresh: a stroke's dabs weight their
     /// samples alike).
     pub fn controls_moved(&mut self, surface: &Surface, controls: &[ControlId]) {
-        let control = surface.control_points();
         let rows = self
             .stencil
             .rows_of_controls(&self.columns, controls.iter().map(|c| c.index()));
+        self.evaluate(
+            surface.control_points(),
+            rows.into_iter().map(|r| r as usize),
+        );
+    }
+
+    /// The positions and tangents of `rows` from `control`.
+    fn evaluate(&mut self, control: &[Point3], rows: impl Iterator<Item = usize>) {
         for r in rows {
-            let (p, t) = self.stencil.position_and_tangents(control, r as usize);
-            self.positions[r as usize] = p;
-            self.tangents[r as usize] = t;
+            (self.positions[r], self.tangents[r]) = self.stencil.position_and_tangents(control, r);
         }
     }
 
@@ -121,15 +121,6 @@ impl SurfaceSamples {
             areas: &self.areas,
             outward: self.outward,
         }
-    }
-
-    /// How many samples there are.
-    pub fn len(&self) -> usize {
-        self.points.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
     }
 }
 

@@ -207,6 +207,21 @@ impl Stencil {
     }
 }
 
+/// Sets, in `bits` (a bit per control point), the first control point of every `width` × `width`
+/// window of a chart's `grid` × `grid` control grid that holds control point `c` (control points
+/// are numbered chart by chart, a grid line after another).
+pub(crate) fn mark_windows_holding(bits: &mut [u64], c: usize, grid: usize, width: usize) {
+    let per_chart = grid * grid;
+    let (base, local) = (c - c % per_chart, c % per_chart);
+    let (row, column) = (local / grid, local % grid);
+    for j in 0..=row.min(width - 1) {
+        for i in 0..=column.min(width - 1) {
+            let first = base + (row - j) * grid + (column - i);
+            bits[first / 64] |= 1 << (first % 64);
+        }
+    }
+}
+
 /// The indices of the set bits of `bits`, in increasing order.
 pub(crate) fn set_bits(bits: &[u64]) -> Vec<u32> {
     let mut out = Vec::new();

@@ -383,18 +383,9 @@ impl TensorStencil {
     /// A bit per control point: set where the order × order window from that point holds one of
     /// `moved`.
     fn windows_holding(&self, moved: &[u32], control_count: usize) -> Vec<u64> {
-        let (g, o) = (self.grid, self.order);
         let mut bits = vec![0u64; control_count.div_ceil(64).max(1)];
         for &m in moved {
-            let m = m as usize;
-            let (base, local) = (m - m % (g * g), m % (g * g));
-            let (row, column) = (local / g, local % g);
-            for j in 0..o.min(row + 1) {
-                for i in 0..o.min(column + 1) {
-                    let first = base + (row - j) * g + (column - i);
-                    bits[first / 64] |= 1 << (first % 64);
-                }
-            }
+            super::mark_windows_holding(&mut bits, m as usize, self.grid, self.order);
         }
         bits
     }
