@@ -728,25 +728,31 @@ proptest! {
             prop_assert_eq!(jet.0, positions[r as usize]);
             prop_assert_eq!(jet.1, tangents[r as usize]);
         }
-        // After some control points move, the rows that use them are updated (to a fresh
-        // evaluation's very numbers), and every other row stays, where the f64 stencil says it
-        // moves by no more than the tensor stencil's own error.
+        // After some control points move, with no lag allowed the rows that use them are updated
+        // (to a fresh evaluation's very numbers), and every other row stays, where the f64
+        // stencil says it moves by no more than the tensor stencil's own error.
         let moved: Vec<u32> = (0..layout.control_count() as u32)
             .filter(|c| (c ^ seed as u32).is_multiple_of(7))
             .collect();
+        let step = Vector3::new(1.0, -2.0, 0.5) * (1e-2 * diagonal);
         let mut after = control.clone();
         for &c in &moved {
-            after[c as usize] += Vector3::new(1.0, -2.0, 0.5) * (1e-2 * diagonal);
+            after[c as usize] += step;
         }
+        let displaced: Vec<(u32, Vector3)> = moved.iter().map(|&c| (c, step)).collect();
         let (mut updated, mut updated_tangents) = (positions.clone(), tangents.clone());
-        let rows = tensor.update_rows_of_controls(
+        let mut lag = vec![0f32; n];
+        let rows = tensor.follow_controls(
             &after,
-            &moved,
+            &displaced,
+            0.0,
+            &mut lag,
             &mut updated,
             &mut updated_tangents,
             |p, t, position, tangents| (*p, *t) = (position, tangents),
         );
         prop_assert!(rows.windows(2).all(|w| w[0] < w[1]));
+        prop_assert!(lag.iter().all(|&l| l == 0.0));
         let mut fresh = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
         tensor.positions_and_tangents(&after, &mut fresh.0, &mut fresh.1);
         for r in 0..n {
@@ -757,6 +763,46 @@ proptest! {
                 prop_assert_eq!(updated[r], positions[r]);
                 let truth = exact_stencil.position(&after, r);
                 prop_assert!((truth - updated[r]).norm() <= 1e-6 * diagonal, "row {} left behind", r);
+            }
+        }
+        // With a lag allowed, over rounds of small motions of varying size and direction every
+        // row stays within its lag of the surface, and its lag within the threshold; the rows
+        // evaluated are exact.
+        let threshold = 1e-3 * diagonal;
+        let mut now = after;
+        for round in 0..6u32 {
+            let displaced: Vec<(u32, Vector3)> = moved
+                .iter()
+                .enumerate()
+                .map(|(k, &c)| {
+                    let phase = f64::from(round) + k as f64 * 0.7;
+                    let d = Vector3::new(phase.sin(), phase.cos(), (2.0 * phase).sin());
+                    (c, d * (threshold * (0.05 + 0.3 * ((k % 5) as f64 / 4.0))))
+                })
+                .collect();
+            for &(c, d) in &displaced {
+                now[c as usize] += d;
+            }
+            let rows = tensor.follow_controls(
+                &now,
+                &displaced,
+                threshold,
+                &mut lag,
+                &mut updated,
+                &mut updated_tangents,
+                |p, t, position, tangents| (*p, *t) = (position, tangents),
+            );
+            tensor.positions_and_tangents(&now, &mut fresh.0, &mut fresh.1);
+            for r in 0..n {
+                prop_assert!(f64::from(lag[r]) < threshold, "row {}: lag {} at or over the threshold", r, lag[r]);
+                let off = (updated[r] - fresh.0[r]).norm();
+                prop_assert!(
+                    off <= f64::from(lag[r]) * (1.0 + 1e-5) + 1e-6 * diagonal,
+                    "round {}, row {}: {:e} off, lag {:e}", round, r, off, lag[r]
+                );
+            }
+            for &r in &rows {
+                prop_assert_eq!(updated[r as usize], fresh.0[r as usize]);
             }
         }
     }

@@ -139,6 +139,10 @@ impl ChartTriangles {
 /// [`LiveMesh::controls_moved`].
 pub const UNSEEN: f64 = 1e-4;
 
+/// The share of [`UNSEEN`] that control points' motions may add up to before the vertices hear of
+/// them (the rest is the vertices' own lag): see [`LiveMesh::controls_moved`].
+const HELD_BACK: f64 = 0.5;
+
 /// The live surface mesh (see the module documentation).
 pub struct LiveMesh {
     pub tessellation: ChartTriangles,
@@ -162,9 +166,13 @@ pub struct LiveMesh {
     /// Made at the first brush's start (a model that is never brushed needs none).
     samples: Option<SurfaceSamples>,
     size: f64,
-    /// Per control point, how far it has moved (summed) since the vertices it reaches were last
-    /// re-evaluated: see [`LiveMesh::controls_moved`].
-    pending: Vec<f64>,
+    /// Per control point, its motion during a stroke since it was last passed on to the vertices
+    /// (see [`LiveMesh::controls_moved`]).
+    pending: Vec<Vector3>,
+    /// Per vertex, a bound on how far it lags the surface during a stroke (its point's motions
+    /// since it was last evaluated, summed): see [`LiveMesh::controls_moved`]. Empty until the
+    /// first dab.
+    lag: Vec<f32>,
     /// The f32 tensor stencil with tangents, made at the first stroke brush's dab: dabs move
     /// their vertices through it (several times faster than the f64 stencil), and the stroke's
     /// end makes them exact again.
@@ -199,6 +207,7 @@ impl LiveMesh {
             samples: None,
             size: 0.0,
             pending: Vec::new(),
+            lag: Vec::new(),
             tensor: None,
         };
         let all: Vec<u32> = (0..n as u32).collect();
@@ -377,11 +386,18 @@ impl LiveMesh {
     /// exact, full evaluation).
     ///
     /// Most of the control points a dab moves lie at its fringe and move very little, yet reach
-    /// half a million vertices at 10⁶. So a control point's vertices are re-evaluated only once
-    /// its motion since they last were adds up to [`UNSEEN`] of the model's size. The weights of a
-    /// row are positive and sum to 1, so no vertex is then ever further than that from where the
-    /// control points put it (a vertex re-evaluated for one control point takes the others'
-    /// motion so far along too).
+    /// half a million vertices at 10⁶. So the vertices follow in two stages, each with a share of
+    /// the allowed lag, [`UNSEEN`] of the model's size:
+    /// - a control point's motion is passed on only once it adds up (as a vector, since it was
+    ///   last passed on) to half of it. A row's weights are positive and sum to 1, so the
+    ///   motions held back move no vertex further than that;
+    /// - each vertex keeps a bound on how far the motions passed on have moved it since it was
+    ///   last evaluated, and is evaluated anew only once that reaches the other half
+    ///   ([`TensorStencil::follow_controls`]: bounding a motion reads a row's position factors
+    ///   alone, and sums scalars).
+    ///
+    /// So no vertex is ever further than [`UNSEEN`] of the size from where the control points put
+    /// it.
     pub fn controls_moved(&mut self, surface: &Surface, moved: &[(ControlId, Vector3)]) {
         let controls: Vec<ControlId> = moved.iter().map(|m| m.0).collect();
         if let Some(samples) = &mut self.samples {
@@ -391,17 +407,16 @@ impl LiveMesh {
             self.controls_changed(surface, &controls);
             return;
         }
-        self.pending.resize(surface.control_points().len(), 0.0);
         let seen = UNSEEN * self.size;
-        let due: Vec<u32> = moved
+        self.pending
+            .resize(surface.control_points().len(), Vector3::zeros());
+        self.lag.resize(self.positions.len(), 0.0);
+        let due: Vec<(u32, Vector3)> = moved
             .iter()
             .filter_map(|&(c, d)| {
                 let pending = &mut self.pending[c.index()];
-                *pending += d.norm();
-                (*pending >= seen).then(|| {
-                    *pending = 0.0;
-                    c.0
-                })
+                *pending += d;
+                (pending.norm() >= HELD_BACK * seen).then(|| (c.0, std::mem::take(pending)))
             })
             .collect();
         if due.is_empty() {
@@ -414,9 +429,11 @@ impl LiveMesh {
         // The vertex and its f64 position are written; the f64 tangents are left as they were
         // (nothing reads them during a stroke, and its end makes them exact again): bytes a
         // vertex need not move.
-        let rows = tensor.update_rows_of_controls(
+        let rows = tensor.follow_controls(
             surface.control_points(),
             &due,
+            (1.0 - HELD_BACK) * seen,
+            &mut self.lag,
             &mut self.positions,
             &mut self.vertices,
             |position, vertex, p, [u, v]| {
@@ -427,8 +444,10 @@ impl LiveMesh {
                 vertex.flags = 0;
             },
         );
-        self.dirty.add_sorted(&rows);
-        self.bvh_stale = true;
+        if !rows.is_empty() {
+            self.dirty.add_sorted(&rows);
+            self.bvh_stale = true;
+        }
     }
 
     /// After `controls` changed: recomputes exactly the rows they touch (and their colours in the
@@ -438,7 +457,7 @@ impl LiveMesh {
         self.rows_changed(surface, &rows);
         for c in controls {
             if let Some(pending) = self.pending.get_mut(c.index()) {
-                *pending = 0.0;
+                *pending = Vector3::zeros();
             }
         }
     }
@@ -486,6 +505,11 @@ impl LiveMesh {
         };
         let points = &self.tessellation.vertices;
         evaluate_rows(surface, &self.stencil, points, rows, wants, 0.0, sink);
+        if !self.lag.is_empty() {
+            for &r in rows {
+                self.lag[r as usize] = 0.0;
+            }
+        }
         if !values.is_empty() {
             let range = *self
                 .curvature_range

@@ -211,15 +211,20 @@ impl Stencil {
 /// window of a chart's `grid` × `grid` control grid that holds control point `c` (control points
 /// are numbered chart by chart, a grid line after another).
 pub(crate) fn mark_windows_holding(bits: &mut [u64], c: usize, grid: usize, width: usize) {
+    for first in windows_holding(c, grid, width) {
+        bits[first / 64] |= 1 << (first % 64);
+    }
+}
+
+/// The first control points of the `width` × `width` windows of a chart's `grid` × `grid` control
+/// grid that hold control point `c`.
+pub(crate) fn windows_holding(c: usize, grid: usize, width: usize) -> impl Iterator<Item = usize> {
     let per_chart = grid * grid;
     let (base, local) = (c - c % per_chart, c % per_chart);
     let (row, column) = (local / grid, local % grid);
-    for j in 0..=row.min(width - 1) {
-        for i in 0..=column.min(width - 1) {
-            let first = base + (row - j) * grid + (column - i);
-            bits[first / 64] |= 1 << (first % 64);
-        }
-    }
+    (0..=row.min(width - 1)).flat_map(move |j| {
+        (0..=column.min(width - 1)).map(move |i| base + (row - j) * grid + (column - i))
+    })
 }
 
 /// The indices of the set bits of `bits`, in increasing order.

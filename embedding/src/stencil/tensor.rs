@@ -20,6 +20,8 @@
 //! from the origin. It is measured against the f64 [`Stencil`](super::Stencil) in
 //! `embedding/tests/surface.rs` (at most 1e-6 of the bounding-box diagonal).
 
+use std::sync::OnceLock;
+
 use charts::ChartPoint;
 use glam::Vec4;
 use rayon::prelude::*;
@@ -42,6 +44,10 @@ const PREFETCH_BLOCKS: usize = 16;
 /// Rows per parallel task: enough to amortise scheduling, few enough to balance the cores.
 const ROWS_PER_TASK: usize = 4096;
 
+/// Rows per parallel task in [`TensorStencil::follow_controls`]: each task looks its range up in
+/// every moved window's list of rows (a binary search), so fewer, larger tasks than elsewhere.
+const FOLLOW_ROWS_PER_TASK: usize = 32_768;
+
 /// Positions = W · control points for a fixed set of surface points, W stored chart by chart in
 /// tensor form (see the module's comment).
 #[derive(Clone, Debug, Default)]
@@ -59,6 +65,63 @@ pub struct TensorStencil {
     /// Empty, or per block [`tangent_words`]`(order)` numbers: N_i'(u), then β · N_j'(v), then
     /// β_u/β, β_v/β, Re ψ', Im ψ' (see the module's comment).
     tangent_factors: Vec<f32>,
+    /// Made at the first [`TensorStencil::follow_controls`]: per window origin, the rows
+    /// with a block there.
+    rows_by_first: OnceLock<RowsByFirst>,
+}
+
+/// The rows with a block at each window origin (a block's first control point), each list
+/// increasing: one entry per block, where a column index has one per weight.
+#[derive(Clone, Debug, Default)]
+struct RowsByFirst {
+    /// Origin f's rows are `rows[starts[f]..starts[f + 1]]`.
+    starts: Vec<u32>,
+    rows: Vec<u32>,
+}
+
+impl RowsByFirst {
+    /// A counting sort of the blocks by first control point, rows visited in order.
+    fn new(row_starts: &[u32], firsts: &[u32]) -> RowsByFirst {
+        let origins = firsts.iter().max().map_or(0, |&f| f as usize + 1);
+        let mut starts = vec![0u32; origins + 1];
+        for &f in firsts {
+            starts[f as usize + 1] += 1;
+        }
+        for k in 1..starts.len() {
+            starts[k] += starts[k - 1];
+        }
+        let mut next = starts.clone();
+        let mut rows = vec![0u32; firsts.len()];
+        for (r, span) in row_starts.windows(2).enumerate() {
+            for &f in &firsts[span[0] as usize..span[1] as usize] {
+                rows[next[f as usize] as usize] = r as u32;
+                next[f as usize] += 1;
+            }
+        }
+        RowsByFirst { starts, rows }
+    }
+
+    /// A bit per row of `rows` (from its start): set where the row has a block at one of
+    /// `origins`.
+    fn rows_between(&self, origins: &[u32], rows: std::ops::Range<usize>) -> Vec<u64> {
+        let mut hit = vec![0u64; rows.len().div_ceil(64)];
+        for &f in origins {
+            let f = f as usize;
+            let Some(list) = self.starts.get(f..f + 2) else {
+                continue;
+            };
+            let list = &self.rows[list[0] as usize..list[1] as usize];
+            let from = list.partition_point(|&r| (r as usize) < rows.start);
+            for &r in list[from..]
+                .iter()
+                .take_while(|&&r| (r as usize) < rows.end)
+            {
+                let k = r as usize - rows.start;
+                hit[k / 64] |= 1 << (k % 64);
+            }
+        }
+        hit
+    }
 }
 
 /// f32 numbers per block that the tangents add, for B-spline order `order`.
@@ -105,6 +168,7 @@ impl TensorStencil {
             } else {
                 0
             }),
+            rows_by_first: OnceLock::new(),
         };
         let block_index = |n: usize| u32::try_from(n).expect("fewer than 2³² chart blocks");
         s.row_starts.push(0);
@@ -308,86 +372,123 @@ impl TensorStencil {
             });
     }
 
-    /// After the control points `moved` changed: the position and tangents anew of every row with
-    /// a block that uses one of them, handed to `write` with that row's entries of `first` and
-    /// `second` (per-row outputs, such as positions and tangents), on all cores; returns those
-    /// rows, in increasing order.
+    /// After control points moved (`moved`: each with its displacement since the last call),
+    /// brings the rows that use them within `threshold` of the surface: every such row's `lag`
+    /// (a bound on how far its last written point is from where the control points now put it)
+    /// grows by a bound on how far the row's point moved; where it reaches `threshold`, the row
+    /// is evaluated anew (position and tangents, handed to `write` with the row's entries of
+    /// `first` and `second`) and its lag set to 0. On all cores; returns the rows evaluated, in
+    /// increasing order. A `threshold` of 0 evaluates every row that uses a moved point.
     ///
-    /// Which rows those are is read from the blocks themselves: a block uses the order × order
-    /// window of its chart's grid from its first control point, so a table over the grid of the
-    /// windows that hold a moved point answers per block in one look-up. One pass over the blocks'
-    /// first indices (4 bytes a block) replaces a column index's millions of scattered entries, and
-    /// the kernel runs in the same pass. Rows where the moved points' charts were left out as
-    /// negligible ([`NEGLIGIBLE_BLEND`]) are not among them: they move by less than that fraction of
-    /// the points' motion.
+    /// The bound: a row's weights w_c are positive, so its point moves by at most Σ_c w_c |Δ_c|.
+    /// Most rows
+    /// a dab reaches lie at its fringe and move very little; those are only bounded (Σ_c w_c |Δ_c|
+    /// from the position factors alone, in scalars), not evaluated.
+    ///
+    /// Finding the rows: a block uses the order × order window of its chart's grid from its first
+    /// control point, so the rows are those listed under the windows that hold a moved point (an
+    /// index of the blocks by first control point, made at the first call: 4 bytes a block).
+    /// Rows where the moved points' charts were left out as negligible ([`NEGLIGIBLE_BLEND`]) are
+    /// not among them: they move by less than that fraction of the points' motion.
     ///
     /// # Panics
-    /// If the stencil was built without tangents, or `first` or `second` is shorter than the
-    /// stencil.
-    pub fn update_rows_of_controls<A: Send, B: Send>(
+    /// If the stencil was built without tangents, or `lag`, `first` or `second` is shorter than
+    /// the stencil.
+    #[allow(clippy::too_many_arguments)]
+    pub fn follow_controls<A: Send, B: Send>(
         &self,
         control: &[Point3],
-        moved: &[u32],
+        moved: &[(u32, Vector3)],
+        threshold: f64,
+        lag: &mut [f32],
         first: &mut [A],
         second: &mut [B],
         write: impl Fn(&mut A, &mut B, Point3, [Vector3; 2]) + Sync,
     ) -> Vec<u32> {
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
-        match self.order {
-            2 => self.update_rows::<2, A, B>(control, moved, first, second, &write),
-            3 => self.update_rows::<3, A, B>(control, moved, first, second, &write),
-            4 => self.update_rows::<4, A, B>(control, moved, first, second, &write),
-            5 => self.update_rows::<5, A, B>(control, moved, first, second, &write),
-            6 => self.update_rows::<6, A, B>(control, moved, first, second, &write),
-            7 => self.update_rows::<7, A, B>(control, moved, first, second, &write),
-            _ => self.update_rows::<8, A, B>(control, moved, first, second, &write),
-        }
-    }
-
-    fn update_rows<const O: usize, A: Send, B: Send>(
-        &self,
-        control: &[Point3],
-        moved: &[u32],
-        first: &mut [A],
-        second: &mut [B],
-        write: &(impl Fn(&mut A, &mut B, Point3, [Vector3; 2]) + Sync),
-    ) -> Vec<u32> {
-        let windows = self.windows_holding(moved, control.len());
-        let frame = ControlFrame::new(control);
         let rows = self.rows();
-        let parts: Vec<Vec<u32>> = first[..rows]
-            .par_chunks_mut(ROWS_PER_TASK)
-            .zip(second[..rows].par_chunks_mut(ROWS_PER_TASK))
+        let (lag, first, second) = (&mut lag[..rows], &mut first[..rows], &mut second[..rows]);
+        // How far each control point moved, and the windows that hold one that did.
+        let mut motion = vec![0f32; control.len()];
+        let mut windows = vec![0u64; control.len().div_ceil(64).max(1)];
+        for &(c, d) in moved {
+            motion[c as usize] = d.norm() as f32;
+            super::mark_windows_holding(&mut windows, c as usize, self.grid, self.order);
+        }
+        let index = self
+            .rows_by_first
+            .get_or_init(|| RowsByFirst::new(&self.row_starts, &self.firsts));
+        let origins = super::set_bits(&windows);
+        let frame = ControlFrame::new(control);
+        let threshold = threshold as f32;
+        let order = self.order;
+        let follow = |r: usize, lag: &mut f32, a: &mut A, b: &mut B| -> bool {
+            *lag += match order {
+                2 => self.motion_bound::<2>(&motion, &windows, r),
+                3 => self.motion_bound::<3>(&motion, &windows, r),
+                4 => self.motion_bound::<4>(&motion, &windows, r),
+                5 => self.motion_bound::<5>(&motion, &windows, r),
+                6 => self.motion_bound::<6>(&motion, &windows, r),
+                7 => self.motion_bound::<7>(&motion, &windows, r),
+                _ => self.motion_bound::<8>(&motion, &windows, r),
+            };
+            if *lag < threshold {
+                return false;
+            }
+            let (p, t) = match order {
+                2 => self.row_jet::<2>(&frame, r),
+                3 => self.row_jet::<3>(&frame, r),
+                4 => self.row_jet::<4>(&frame, r),
+                5 => self.row_jet::<5>(&frame, r),
+                6 => self.row_jet::<6>(&frame, r),
+                7 => self.row_jet::<7>(&frame, r),
+                _ => self.row_jet::<8>(&frame, r),
+            };
+            write(a, b, p, t);
+            *lag = 0.0;
+            true
+        };
+        // Each task takes a range of rows, finds those a moved window reaches there (a bit each)
+        // and follows them in order.
+        let parts: Vec<Vec<u32>> = lag
+            .par_chunks_mut(FOLLOW_ROWS_PER_TASK)
+            .zip(first.par_chunks_mut(FOLLOW_ROWS_PER_TASK))
+            .zip(second.par_chunks_mut(FOLLOW_ROWS_PER_TASK))
             .enumerate()
-            .map(|(k, (first, second))| {
-                let start = k * ROWS_PER_TASK;
-                let mut touched = Vec::new();
-                for (i, (a, b)) in first.iter_mut().zip(second).enumerate() {
-                    let r = start + i;
-                    let blocks = self.row_starts[r] as usize..self.row_starts[r + 1] as usize;
-                    if self.firsts[blocks]
-                        .iter()
-                        .any(|&f| windows[f as usize / 64] & (1 << (f % 64)) != 0)
-                    {
-                        let (p, t) = self.row_jet::<O>(&frame, r);
-                        write(a, b, p, t);
-                        touched.push(r as u32);
-                    }
-                }
-                touched
+            .map(|(t, ((lag, a), b))| {
+                let start = t * FOLLOW_ROWS_PER_TASK;
+                let reached = index.rows_between(&origins, start..start + lag.len());
+                super::set_bits(&reached)
+                    .into_iter()
+                    .filter(|&k| {
+                        let k = k as usize;
+                        follow(start + k, &mut lag[k], &mut a[k], &mut b[k])
+                    })
+                    .map(|k| (start + k as usize) as u32)
+                    .collect()
             })
             .collect();
         parts.concat()
     }
 
-    /// A bit per control point: set where the order × order window from that point holds one of
-    /// `moved`.
-    fn windows_holding(&self, moved: &[u32], control_count: usize) -> Vec<u64> {
-        let mut bits = vec![0u64; control_count.div_ceil(64).max(1)];
-        for &m in moved {
-            super::mark_windows_holding(&mut bits, m as usize, self.grid, self.order);
+    /// Σ_c w_c |Δ_c| over row `r`'s blocks in a window marked in `windows`, `motion` holding
+    /// |Δ_c| per control point: at least how far the row's point moved, |Σ_c w_c Δ_c|.
+    fn motion_bound<const O: usize>(&self, motion: &[f32], windows: &[u64], r: usize) -> f32 {
+        let mut bound = 0.0;
+        for k in self.row_starts[r] as usize..self.row_starts[r + 1] as usize {
+            let first = self.firsts[k] as usize;
+            if windows[first / 64] & (1 << (first % 64)) == 0 {
+                continue;
+            }
+            let (u, v) = self.factors[2 * O * k..2 * O * (k + 1)].split_at(O);
+            for (j, &vj) in v.iter().enumerate() {
+                let start = first + j * self.grid;
+                let line: &[f32; O] = motion[start..start + O].try_into().expect("a block line");
+                let s: f32 = u.iter().zip(line).map(|(&ui, &m)| ui * m).sum();
+                bound += vj * s;
+            }
         }
-        bits
+        bound
     }
 
     /// One row of [`TensorStencil::tangent_kernel`] (by the cubic AVX kernel where it runs).
