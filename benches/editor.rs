@@ -14,8 +14,10 @@
 //! - `brush_start` and `brush_event`: the same with an influence radius of 15% (a grab brush:
 //!   planning adds the least-squares shares of the falloff field);
 //! - `stroke_step_inflate`, `_smooth`, `_flatten`: one step of a stroke (a dab: the brush's fit,
-//!   the new control points and the exact re-evaluation of the vertices they reach) of a brush
-//!   whose disc covers 5% of the surface's area.
+//!   the new control points and the vertices they reach, within `UNSEEN` of the surface) of a
+//!   brush whose disc covers 5% of the surface's area;
+//! - `pick_after_dab`: the pick under the pointer that comes before the next dab (a smooth
+//!   stroke's), with the picking boxes of the vertices the dab moved refitted.
 
 use std::hint::black_box;
 
@@ -239,6 +241,29 @@ fn stroke_steps(
                 })
             },
         );
+        if kind == BrushKind::Smooth {
+            // The editor picks the surface point under the pointer before every dab: the first
+            // pick after a dab refits the picking boxes of the vertices it moved.
+            group.bench_function(BenchmarkId::new("pick_after_dab", n), |b| {
+                b.iter_custom(|iters| {
+                    let mut total = std::time::Duration::ZERO;
+                    for _ in 0..iters {
+                        if state.stroke().is_none_or(|s| s.dabs >= STROKE) {
+                            state.cancel_drag();
+                            state.start_stroke(point).unwrap();
+                            state.pick([400.0, 300.0]);
+                            flip = false;
+                        }
+                        flip = !flip;
+                        state.stroke_at(if flip { other } else { point }).unwrap();
+                        let started = std::time::Instant::now();
+                        black_box(state.pick(black_box([400.0, 300.0])));
+                        total += started.elapsed();
+                    }
+                    total
+                })
+            });
+        }
         if dabs > 0 {
             println!(
                 "{}: {dabs} dabs, {:.0} control points moved on average",

@@ -95,6 +95,37 @@ impl Dirty {
     }
 }
 
+/// The vertices that moved since the picking boxes were last refitted: a bit each.
+#[derive(Clone, Debug, Default)]
+struct Unfitted {
+    bits: Vec<u64>,
+    /// At least the number of bits set (a vertex that moves twice counts twice).
+    count: usize,
+}
+
+impl Unfitted {
+    fn add(&mut self, rows: &[u32], vertex_count: usize) {
+        self.bits.resize(vertex_count.div_ceil(64), 0);
+        for &r in rows {
+            self.bits[r as usize / 64] |= 1 << (r % 64);
+        }
+        self.count += rows.len();
+    }
+
+    fn vertices(&self) -> impl Iterator<Item = u32> + '_ {
+        self.bits.iter().enumerate().flat_map(|(w, &word)| {
+            let mut bits = word;
+            std::iter::from_fn(move || {
+                (bits != 0).then(|| {
+                    let b = bits.trailing_zeros();
+                    bits &= bits - 1;
+                    (w * 64) as u32 + b
+                })
+            })
+        })
+    }
+}
+
 /// The triangles the viewport shows, every vertex a chart point: the quality tessellation or the
 /// t_e/t_r one.
 #[derive(Clone, Debug, Default)]
@@ -156,7 +187,8 @@ pub struct LiveMesh {
     /// A new vertex or index count: the GPU buffers must be made anew.
     pub(crate) rebuilt: bool,
     bvh: Bvh,
-    bvh_stale: bool,
+    /// The vertices that moved since the picking boxes were last refitted.
+    unfitted: Unfitted,
     style: Style,
     /// The curvature style's colour range (kept during edits so colours stay comparable).
     curvature_range: Option<f64>,
@@ -201,7 +233,7 @@ impl LiveMesh {
             },
             rebuilt: true,
             bvh: Bvh::default(),
-            bvh_stale: true,
+            unfitted: Unfitted::default(),
             style,
             curvature_range: None,
             samples: None,
@@ -214,7 +246,7 @@ impl LiveMesh {
         mesh.evaluate(surface, &all, true);
         mesh.refresh_size();
         mesh.bvh = Bvh::build(&mesh.positions, &mesh.tessellation.triangles);
-        mesh.bvh_stale = false;
+        mesh.unfitted = Unfitted::default();
         Ok(mesh)
     }
 
@@ -335,10 +367,14 @@ impl LiveMesh {
     /// The nearest triangle the ray meets (the picking boxes are refitted first if the surface
     /// moved since).
     pub fn cast(&mut self, ray: &Ray) -> Option<Hit> {
-        if self.bvh_stale {
+        let moved = std::mem::take(&mut self.unfitted);
+        let triangles = &self.tessellation.triangles;
+        // Past a quarter of the vertices, one pass over every box is the cheaper way.
+        if 4 * moved.count > self.positions.len() {
+            self.bvh.refit(&self.positions, triangles);
+        } else if moved.count > 0 {
             self.bvh
-                .refit(&self.positions, &self.tessellation.triangles);
-            self.bvh_stale = false;
+                .refit_vertices(&self.positions, triangles, moved.vertices());
         }
         self.bvh
             .cast(ray, &self.positions, &self.tessellation.triangles)
@@ -446,7 +482,7 @@ impl LiveMesh {
         );
         if !rows.is_empty() {
             self.dirty.add_sorted(&rows);
-            self.bvh_stale = true;
+            self.unfitted.add(&rows, self.positions.len());
         }
     }
 
@@ -519,7 +555,7 @@ impl LiveMesh {
             }
         }
         self.dirty.add_sorted(rows);
-        self.bvh_stale = true;
+        self.unfitted.add(rows, self.positions.len());
     }
 
     /// The curvature style's colour range (95th percentile of |curvature| when the style was set).
