@@ -64,6 +64,8 @@ struct Links {
     /// Vertex v's leaves are `leaves[starts[v]..starts[v + 1]]`.
     starts: Vec<u32>,
     leaves: Vec<u32>,
+    /// The triangles' corners in the tree's order (`order`), so a leaf's are read in one run.
+    corners: Vec<[u32; 3]>,
 }
 
 impl Links {
@@ -97,10 +99,12 @@ impl Links {
             starts[k] += starts[k - 1];
         }
         let leaves = pairs.into_iter().map(|(_, leaf)| leaf).collect();
+        let corners = bvh.order.iter().map(|&t| triangles[t as usize]).collect();
         Links {
             parents,
             starts,
             leaves,
+            corners,
         }
     }
 }
@@ -171,7 +175,7 @@ impl Bvh {
             let mut bits = word;
             while bits != 0 {
                 let top = 63 - bits.leading_zeros() as usize;
-                self.fit_node(w * 64 + top, positions, triangles);
+                self.fit_node_from(w * 64 + top, positions, &links.corners);
                 bits &= !(1 << top);
             }
         }
@@ -181,11 +185,30 @@ impl Bvh {
     /// Node `i`'s box anew, from its triangles (a leaf) or its children's boxes.
     fn fit_node(&mut self, i: usize, positions: &[Point3], triangles: &[[u32; 3]]) {
         let node = self.nodes[i];
+        let range = node.first as usize..(node.first + node.count) as usize;
+        let corners = self.order[range].iter().map(|&t| &triangles[t as usize]);
+        (self.nodes[i].lo, self.nodes[i].hi) = self.node_box(i, positions, corners);
+    }
+
+    /// [`Bvh::fit_node`] with the triangles' corners in the tree's order ([`Links::corners`]).
+    fn fit_node_from(&mut self, i: usize, positions: &[Point3], corners: &[[u32; 3]]) {
+        let node = self.nodes[i];
+        let range = node.first as usize..(node.first + node.count) as usize;
+        (self.nodes[i].lo, self.nodes[i].hi) = self.node_box(i, positions, corners[range].iter());
+    }
+
+    /// Node `i`'s box from the corners of its triangles (a leaf) or from its children's boxes.
+    fn node_box<'a>(
+        &self,
+        i: usize,
+        positions: &[Point3],
+        corners: impl Iterator<Item = &'a [u32; 3]>,
+    ) -> ([f64; 3], [f64; 3]) {
+        let node = self.nodes[i];
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         if node.count > 0 {
-            let range = node.first as usize..(node.first + node.count) as usize;
-            for &t in &self.order[range] {
-                for &v in &triangles[t as usize] {
+            for triangle in corners {
+                for &v in triangle {
                     let p = positions[v as usize];
                     for a in 0..3 {
                         lo[a] = lo[a].min(p[a]);
@@ -201,8 +224,7 @@ impl Bvh {
                 }
             }
         }
-        self.nodes[i].lo = lo;
-        self.nodes[i].hi = hi;
+        (lo, hi)
     }
 
     /// The nearest hit in front of the ray's origin, if any.
