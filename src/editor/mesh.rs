@@ -8,6 +8,7 @@
 //! barycentric coordinates.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use bytemuck::{Pod, Zeroable};
 use charts::{ChartId, ChartPoint};
@@ -101,15 +102,28 @@ struct Unfitted {
     bits: Vec<u64>,
     /// At least the number of bits set (a vertex that moves twice counts twice).
     count: usize,
+    /// No vertex moved further than this since the boxes were fitted: after dabs only, whose
+    /// vertices move a little at a time ([`LiveMesh::controls_moved`]). A ray is cast against
+    /// the boxes grown by it.
+    slack: f64,
+    /// Whether vertices moved by an unknown amount (an exact evaluation: an undo, a stroke's
+    /// end): the boxes must be refitted before the next ray.
+    tighten: bool,
 }
 
 impl Unfitted {
-    fn add(&mut self, rows: &[u32], vertex_count: usize) {
+    /// Vertices moved by at most `moved` (infinite: unknown).
+    fn add(&mut self, rows: &[u32], vertex_count: usize, moved: f64) {
         self.bits.resize(vertex_count.div_ceil(64), 0);
         for &r in rows {
             self.bits[r as usize / 64] |= 1 << (r % 64);
         }
         self.count += rows.len();
+        if moved.is_finite() {
+            self.slack += moved;
+        } else {
+            self.tighten = true;
+        }
     }
 
     fn vertices(&self) -> impl Iterator<Item = u32> + '_ {
@@ -173,6 +187,11 @@ pub const UNSEEN: f64 = 1e-4;
 /// The share of [`UNSEEN`] that control points' motions may add up to before the vertices hear of
 /// them (the rest is the vertices' own lag): see [`LiveMesh::controls_moved`].
 const HELD_BACK: f64 = 0.5;
+
+/// During a stroke the picking boxes are refitted once the vertices may have left them by this
+/// fraction of the model's size; until then a ray is cast against the boxes grown by how far
+/// (a ray then meets a few hundred more triangles' boxes at 10⁶ vertices).
+const SLACK: f64 = 0.01;
 
 /// The live surface mesh (see the module documentation).
 pub struct LiveMesh {
@@ -367,17 +386,20 @@ impl LiveMesh {
     /// The nearest triangle the ray meets (the picking boxes are refitted first if the surface
     /// moved since).
     pub fn cast(&mut self, ray: &Ray) -> Option<Hit> {
-        let moved = std::mem::take(&mut self.unfitted);
         let triangles = &self.tessellation.triangles;
-        // Past a quarter of the vertices, one pass over every box is the cheaper way.
-        if 4 * moved.count > self.positions.len() {
-            self.bvh.refit(&self.positions, triangles);
-        } else if moved.count > 0 {
-            self.bvh
-                .refit_vertices(&self.positions, triangles, moved.vertices());
+        let unfitted = &self.unfitted;
+        if unfitted.tighten || unfitted.slack > SLACK * self.size {
+            let moved = std::mem::take(&mut self.unfitted);
+            // Past a quarter of the vertices, one pass over every box is the cheaper way.
+            if 4 * moved.count > self.positions.len() {
+                self.bvh.refit(&self.positions, triangles);
+            } else if moved.count > 0 {
+                self.bvh
+                    .refit_vertices(&self.positions, triangles, moved.vertices());
+            }
         }
-        self.bvh
-            .cast(ray, &self.positions, &self.tessellation.triangles)
+        let pad = self.unfitted.slack;
+        self.bvh.cast(ray, &self.positions, triangles, pad)
     }
 
     /// The centre of the bounding box and the largest distance from it.
@@ -465,6 +487,7 @@ impl LiveMesh {
         // The vertex and its f64 position are written; the f64 tangents are left as they were
         // (nothing reads them during a stroke, and its end makes them exact again): bytes a
         // vertex need not move.
+        let farthest = AtomicU64::new(0);
         let rows = tensor.follow_controls(
             surface.control_points(),
             &due,
@@ -474,6 +497,12 @@ impl LiveMesh {
             &mut self.vertices,
             |position, vertex, p, [u, v]| {
                 let n = u.cross(&v).normalize();
+                // Non-negative floats order as their bits do. Loaded first: the largest is soon
+                // found, and then the cores only read the shared word.
+                let moved = (p - *position).norm().to_bits();
+                if moved > farthest.load(Ordering::Relaxed) {
+                    farthest.fetch_max(moved, Ordering::Relaxed);
+                }
                 *position = p;
                 vertex.position = [p.x as f32, p.y as f32, p.z as f32];
                 vertex.normal = [n.x as f32, n.y as f32, n.z as f32];
@@ -482,7 +511,8 @@ impl LiveMesh {
         );
         if !rows.is_empty() {
             self.dirty.add_sorted(&rows);
-            self.unfitted.add(&rows, self.positions.len());
+            let farthest = f64::from_bits(farthest.into_inner());
+            self.unfitted.add(&rows, self.positions.len(), farthest);
         }
     }
 
@@ -555,7 +585,7 @@ impl LiveMesh {
             }
         }
         self.dirty.add_sorted(rows);
-        self.unfitted.add(rows, self.positions.len());
+        self.unfitted.add(rows, self.positions.len(), f64::INFINITY);
     }
 
     /// The curvature style's colour range (95th percentile of |curvature| when the style was set).

@@ -227,8 +227,16 @@ impl Bvh {
         (lo, hi)
     }
 
-    /// The nearest hit in front of the ray's origin, if any.
-    pub fn cast(&self, ray: &Ray, positions: &[Point3], triangles: &[[u32; 3]]) -> Option<Hit> {
+    /// The nearest hit in front of the ray's origin, if any, with every box grown by `pad` on
+    /// each side (vertices may have moved by that much since the boxes were fitted: the hit is
+    /// still exact, the triangles are tested where they are).
+    pub fn cast(
+        &self,
+        ray: &Ray,
+        positions: &[Point3],
+        triangles: &[[u32; 3]],
+        pad: f64,
+    ) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -238,7 +246,7 @@ impl Bvh {
         while let Some(i) = stack.pop() {
             let node = &self.nodes[i];
             let limit = best.map_or(f64::INFINITY, |h| h.t);
-            if !slab(ray, &inverse, node, limit) {
+            if !slab(ray, &inverse, node, limit, pad) {
                 continue;
             }
             if node.count > 0 {
@@ -312,16 +320,17 @@ fn empty_node() -> Node {
     }
 }
 
-/// Does the ray meet the box before `limit`? (The slab test, with a relative margin so that a ray
-/// grazing a flat box is not lost to rounding.)
-fn slab(ray: &Ray, inverse: &[f64; 3], node: &Node, limit: f64) -> bool {
+/// Does the ray meet the box, grown by `grow` on each side, before `limit`? (The slab test, with
+/// a relative margin so that a ray grazing a flat box is not lost to rounding.)
+fn slab(ray: &Ray, inverse: &[f64; 3], node: &Node, limit: f64, grow: f64) -> bool {
     let (mut t0, mut t1) = (0.0f64, limit);
     for (a, inv) in inverse.iter().enumerate() {
-        let pad = 1e-12
-            * (node.hi[a] - node.lo[a])
-                .abs()
-                .max(node.lo[a].abs())
-                .max(1.0);
+        let pad = grow
+            + 1e-12
+                * (node.hi[a] - node.lo[a])
+                    .abs()
+                    .max(node.lo[a].abs())
+                    .max(1.0);
         let (lo, hi) = (node.lo[a] - pad, node.hi[a] + pad);
         let (mut near, mut far) = ((lo - ray.origin[a]) * inv, (hi - ray.origin[a]) * inv);
         if near > far {
@@ -439,6 +448,40 @@ mod tests {
                 let mut whole = partial.clone();
                 whole.refit(&positions, &triangles);
                 prop_assert_eq!(boxes(&partial), boxes(&whole));
+            }
+        }
+
+        /// After vertices move by at most `pad` with the boxes left as they were, a ray cast
+        /// against the boxes grown by `pad` hits what testing every triangle hits (a grid of
+        /// rays over the mesh, tilted).
+        #[test]
+        fn a_grown_cast_finds_what_moved_out_of_its_box(
+            n in 2u32..16,
+            heights in prop::collection::vec(-1.0f64..1.0, 1..50),
+            moves in prop::collection::vec((0usize..10_000, prop::array::uniform3(-1.0f64..1.0)), 1..60),
+            pad in 0.2f64..2.0,
+            tilt in prop::array::uniform2(-0.3f64..0.3),
+        ) {
+            let (mut positions, triangles) = grid(n, &heights);
+            let bvh = Bvh::build(&positions, &triangles);
+            // Each vertex once, by less than `pad`.
+            let mut moved = vec![false; positions.len()];
+            for &(k, d) in &moves {
+                let v = k % positions.len();
+                let d = embedding::Vector3::from(d);
+                if !std::mem::replace(&mut moved[v], true) {
+                    positions[v] += d * (pad / d.norm().max(1e-9) / 1.01);
+                }
+            }
+            let direction = embedding::Vector3::new(tilt[0], tilt[1], -1.0).normalize();
+            let steps = 4 * n;
+            for k in 0..steps * steps {
+                let (i, j) = (k % steps, k / steps);
+                let at = |i: u32| f64::from(i) * f64::from(n) / f64::from(steps) - 0.5;
+                let ray = Ray { origin: Point3::new(at(i), at(j), 5.0), direction };
+                let found = bvh.cast(&ray, &positions, &triangles, pad);
+                let truth = cast_all(&ray, &positions, &triangles);
+                prop_assert_eq!(found.map(|h| h.t), truth.map(|h| h.t), "ray {}", k);
             }
         }
     }
