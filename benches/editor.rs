@@ -16,8 +16,9 @@
 //! - `stroke_step_inflate`, `_smooth`, `_flatten`: one step of a stroke (a dab: the brush's fit,
 //!   the new control points and the vertices they reach, within `UNSEEN` of the surface) of a
 //!   brush whose disc covers 5% of the surface's area;
-//! - `pick_after_dab`: the pick under the pointer that comes before the next dab (a smooth
-//!   stroke's), with the picking boxes of the vertices the dab moved refitted.
+//! - `pick_after_dab_inflate`, `_smooth`, `_flatten`: the pick under the pointer that comes
+//!   before a stroke's next dab (the picking boxes are refitted once the dabs have moved vertices
+//!   far enough out of them, otherwise grown).
 
 use std::hint::black_box;
 
@@ -241,10 +242,11 @@ fn stroke_steps(
                 })
             },
         );
-        if kind == BrushKind::Smooth {
+        {
             // The editor picks the surface point under the pointer before every dab: the first
             // pick after a dab refits the picking boxes of the vertices it moved.
-            group.bench_function(BenchmarkId::new("pick_after_dab", n), |b| {
+            let name = format!("pick_after_dab_{}", kind.name());
+            group.bench_function(BenchmarkId::new(name, n), |b| {
                 b.iter_custom(|iters| {
                     let mut total = std::time::Duration::ZERO;
                     for _ in 0..iters {
