@@ -13,6 +13,8 @@
 //!   drag;
 //! - `brush_start` and `brush_event`: the same with an influence radius of 15% (a grab brush:
 //!   planning adds the least-squares shares of the falloff field);
+//! - `brush_replan_event`: an event that carries the grabbed point a quarter of the radius or more
+//!   along the surface, so the grab plans anew from there (see `editor::drag::Replan`);
 //! - `stroke_step_inflate`, `_smooth`, `_flatten`: one step of a stroke (a dab: the brush's fit,
 //!   the new control points and the vertices they reach, within `UNSEEN` of the surface) of a
 //!   brush whose disc covers 5% of the surface's area;
@@ -150,6 +152,31 @@ fn drag(c: &mut Criterion) {
             b.iter(|| state.drag_to_target(black_box(target())).unwrap())
         });
         state.cancel_drag();
+        // An event that carries the point 0.3 R along the surface: the grab plans anew once.
+        group.bench_function(BenchmarkId::new("brush_replan_event", n), |b| {
+            b.iter_custom(|iters| {
+                let mut total = std::time::Duration::ZERO;
+                for _ in 0..iters {
+                    state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+                    let plan = &state.drag().expect("a drag").plan;
+                    let normal = plan.start_normal;
+                    let side = normal.cross(&Vector3::new(0.6, 0.8, 0.0)).normalize();
+                    let to = plan.start_position + side * (0.3 * state.radius());
+                    let started = std::time::Instant::now();
+                    state.drag_to_target(black_box(to)).unwrap();
+                    total += started.elapsed();
+                    assert_eq!(
+                        state
+                            .drag()
+                            .and_then(|d| d.replan.as_ref())
+                            .map(|r| r.count),
+                        Some(1)
+                    );
+                    state.cancel_drag();
+                }
+                total
+            })
+        });
         // The drags above left their releases in the surface: strokes start from the model.
         let (mut fresh, point) = setup(&model, t);
         stroke_steps(&mut group, &mut fresh, point, n);

@@ -1617,6 +1617,91 @@ fn symmetric_edits_stay_symmetric(sphere: embedding::Surface, meshing: Meshing) 
     );
 }
 
+/// A grab brush pulled along the surface further than its radius can bend (0.8 R, where the
+/// smooth profile's map x + Δ f(|x − c| / R) would fold past 0.58 R) drags a smooth bump along:
+/// it plans anew every quarter of the radius, so no part of the top face under the brush turns
+/// over (the rims of the holes nearby tilt the normals there: the lowest z is 0.30 before the
+/// pull). One undo step, and Escape puts every control point back, however many plans the drag
+/// made.
+#[test]
+fn a_long_grab_along_the_surface_does_not_fold_it() {
+    let mut state = brush_state();
+    let size = state.size();
+    let original = state.control().to_vec();
+    let point = top_point(&state, 0.3 * size);
+    let at = state.surface_point(point);
+    state.influence = 0.12;
+    let radius = state.radius();
+    let undo_steps = state.history().len();
+    let facing_up = |state: &EditorState| {
+        state
+            .mesh()
+            .positions()
+            .iter()
+            .zip(state.mesh().tangents())
+            .filter(|(p, _)| (**p - at).norm() < 2.0 * radius && p.z > at.z - 0.2 * radius)
+            .map(|(_, [u, v])| u.cross(v).normalize().z)
+            .fold(f64::INFINITY, f64::min)
+    };
+    println!(
+        "before: the normals near the point face up at least {:.3}",
+        facing_up(&state)
+    );
+    for cancel in [false, true] {
+        state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+        for k in 1..=8 {
+            let to = at + Vector3::new(0.0, 0.1 * f64::from(k) * radius, 0.0);
+            state.drag_to_target(to).unwrap();
+        }
+        let plans = state
+            .drag()
+            .and_then(|d| d.replan.as_ref())
+            .map_or(0, |r| r.count);
+        if cancel {
+            state.cancel_drag();
+            assert_eq!(
+                state.control(),
+                &original[..],
+                "Escape restores every control point"
+            );
+            let exact = EditorState::new(state.surface().clone(), Meshing::default()).unwrap();
+            let off = state
+                .mesh()
+                .positions()
+                .iter()
+                .zip(exact.mesh().positions())
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            assert!(off < 1e-9 * size, "the vertices are back too: {off:e}");
+            continue;
+        }
+        state.release();
+        let lowest = facing_up(&state);
+        println!(
+            "after a pull of 0.8 R along the surface ({plans} plans after the first): {lowest:.3}"
+        );
+        assert!(plans >= 3, "the grab planned anew as it went: {plans}");
+        // Without planning anew the lowest is -1.000: the bump's front folds right over.
+        assert!(
+            lowest > 0.0,
+            "the top face turned over: a normal's z is {lowest:.3}"
+        );
+        let reached =
+            (state.surface_point(point) - (at + Vector3::new(0.0, 0.8 * radius, 0.0))).norm();
+        assert!(
+            reached < 1e-6 * size,
+            "the point reached the pointer: {reached:e} off"
+        );
+        assert_eq!(state.history().len(), undo_steps + 1, "one undo step");
+        state.undo().unwrap();
+        assert_eq!(
+            state.control(),
+            &original[..],
+            "the undo restores every control point"
+        );
+    }
+}
+
 /// With mirror symmetry the picked point's image, found on the surface, moves too, in the same
 /// solve: on a mirror-symmetric model (the sphere is symmetric in z to 4e-16) the edited surface
 /// stays symmetric to 1e-6 of its size, for a grab and for a stroke brush, whether the view shows
@@ -1729,15 +1814,22 @@ fn brush_keys_strokes_and_the_radius_ring() {
         }
         let before = harness.state().state().unwrap().control().to_vec();
         let undo_steps = harness.state().state().unwrap().history().len();
+        // Stroke brushes paint along a path; the grab pulls up the screen, which on the plate's
+        // top face seen from above is mostly along the normal: a dome (a long pull along the
+        // surface folds it, as a grab does in any modeller: `brush-grab-sideways.png`).
+        let path = match kind {
+            BrushKind::Grab => Vec2::new(0.0, -40.0),
+            _ => Vec2::new(60.0, -30.0),
+        };
         harness.hover_at(start);
         harness.step();
         harness.drag_at(start);
         harness.step();
         for i in 1..=10 {
-            harness.hover_at(start + Vec2::new(6.0 * i as f32, -3.0 * i as f32));
+            harness.hover_at(start + path * (i as f32 / 10.0));
             harness.step();
         }
-        harness.drop_at(start + Vec2::new(60.0, -30.0));
+        harness.drop_at(start + path);
         harness.run();
         let state = harness.state().state().unwrap();
         assert_ne!(state.control(), &before[..], "{kind:?} changed the surface");
@@ -1746,11 +1838,11 @@ fn brush_keys_strokes_and_the_radius_ring() {
             undo_steps + 1,
             "{kind:?}: the stroke is one undo step"
         );
-        let path = artefact_dir().join(format!("brush-{}.png", kind.name()));
-        harness.hover_at(start + Vec2::new(60.0, -30.0));
+        let picture = artefact_dir().join(format!("brush-{}.png", kind.name()));
+        harness.hover_at(start + path);
         harness.run();
-        harness.render().unwrap().save(&path).unwrap();
-        println!("after a {} stroke: {}", kind.name(), path.display());
+        harness.render().unwrap().save(&picture).unwrap();
+        println!("after a {} stroke: {}", kind.name(), picture.display());
         harness.key_press_modifiers(Modifiers::COMMAND, Key::Z);
         harness.run();
         assert_eq!(

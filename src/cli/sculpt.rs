@@ -23,9 +23,11 @@ use super::report::{Report, emit};
 /// grab (the default) drags the surface point nearest to --at to --to. With --radius the surface
 /// within R (model units) of it follows, fading out at the radius as --falloff says (smooth: a
 /// soft round bump; dome: a hemisphere's profile; sharp: a pointed tip; constant: the whole disc
-/// moves together); without, the smallest change of the control points moves it (the paper's
-/// edit). Either way the point reaches --to exactly, and the model's pins and the --pin points
-/// stay where they are (--pin holds for this stroke only; the output keeps the model's own pins).
+/// moves together), planned anew every quarter of the radius of the way, so a long pull along
+/// the surface drags a bump along instead of folding it; without, the smallest change of the
+/// control points moves it (the paper's edit). Either way the point reaches --to exactly, and the
+/// model's pins and the --pin points stay where they are (--pin holds for this stroke only; the
+/// output keeps the model's own pins).
 ///
 /// inflate, smooth and flatten are stroke brushes: a dab at the surface point nearest to --at,
 /// or, with --to, dabs a quarter of the radius apart along the way from --at to --to (each at the

@@ -51,11 +51,40 @@ pub struct Drag {
     pub plan: DragPlan,
     pub press_pixel: [f64; 2],
     pub grab: Grab,
+    /// Where the dragged point was, and the control points, when the drag began (a drag may
+    /// make several plans: see [`Replan`]).
+    pub origin: Point3,
+    pub origin_control: Vec<Point3>,
+    /// A grab brush's: how to plan anew as the point travels.
+    pub replan: Option<Replan>,
     pub events: u32,
     /// Time spent in drag events (solve and vertex update), in total and the last one.
     pub busy: Duration,
     pub last: Duration,
 }
+
+/// A grab brush moves the surface around the point by Δ times a falloff of the distance, and on
+/// the surface the map x ↦ x + Δ f(|x − c| / R) folds once |Δ_t| · max |f′| / R reaches 1, Δ_t
+/// the part of Δ along the surface (a pull along the normal raises a bump and never folds): a pull
+/// along the surface of about half the radius. So a grab brush plans anew, from where the surface
+/// then is, each time the point has travelled [`REPLAN`] of the radius along the surface since
+/// the last plan: the region follows the pointer a step at a time, each step a map that cannot
+/// fold, and a pull along the surface drags a smooth bump along instead of folding it.
+#[derive(Clone, Debug)]
+pub struct Replan {
+    /// How far the point travels along the surface under one plan (model units).
+    pub step: f64,
+    pub pins: Vec<ChartPoint>,
+    pub brush: (f64, Falloff),
+    pub images: Vec<(ChartPoint, Vector3)>,
+    /// Plans made after the first.
+    pub count: u32,
+}
+
+/// A grab brush's plan carries the point this fraction of the radius (see [`Replan`]): the
+/// smooth profile's steepest slope is 1.72, so one plan's map stretches the surface by at most
+/// 1 − 0.43 and cannot fold it.
+pub const REPLAN: f64 = 0.25;
 
 /// The last finished drag: what moved where, and how long its events took.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,6 +119,8 @@ pub struct DragPlan {
     /// The dragged surface point and where it was when the drag began.
     pub point: ChartPoint,
     pub start_position: Point3,
+    /// The surface's unit normal there.
+    pub start_normal: Vector3,
     /// The pins as constraints (targets: where they were when the drag began).
     pub pins: Vec<Constraint>,
     /// The control points when the drag began.
@@ -127,7 +158,8 @@ impl DragPlan {
     ) -> Result<DragPlan, EmbeddingError> {
         let layout = &surface.layout();
         let control = surface.control_points();
-        let start_position = layout.eval(control, point).pos;
+        let start = layout.eval(control, point);
+        let (start_position, start_normal) = (start.pos, start.normal());
         let images: Vec<(ChartPoint, Point3, Vector3)> = images
             .iter()
             .map(|&(p, signs)| (p, layout.eval(control, p).pos, signs))
@@ -190,6 +222,7 @@ impl DragPlan {
         let mut plan = DragPlan {
             point,
             start_position,
+            start_normal,
             pins,
             start_control: control.to_vec(),
             images,

@@ -12,7 +12,7 @@ use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surfa
 
 use super::camera::{OrbitCamera, to_point};
 pub use super::drag::{Drag, DragStats, Grab};
-use super::drag::{DragPlan, DragRow};
+use super::drag::{DragPlan, DragRow, REPLAN, Replan};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
@@ -436,19 +436,34 @@ impl EditorState {
             .filter(|&(i, _)| grab != Grab::Pin(i))
             .map(|(_, &p)| p)
             .collect();
+        // The samples and the model's size first: the radius is a fraction of the size as it is
+        // now (a cancelled drag may have left the size of a surface it undid).
+        if self.influence > 0.0 {
+            self.mesh.refresh_brush_weights(&self.surface)?;
+        }
         let brush = (self.influence > 0.0).then(|| (self.radius(), self.falloff));
         let images = match grab {
             Grab::Surface => self.mirror_images(point),
             Grab::Pin(_) => Vec::new(),
         };
-        if brush.is_some() {
-            self.mesh.refresh_brush_weights(&self.surface)?;
-        }
         let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, brush, &images)?;
+        let replan = match (grab, brush) {
+            (Grab::Surface, Some(brush)) => Some(Replan {
+                step: REPLAN * brush.0,
+                pins,
+                brush,
+                images,
+                count: 0,
+            }),
+            _ => None,
+        };
         self.drag = Some(Drag {
+            origin: plan.start_position,
+            origin_control: plan.start_control.clone(),
             plan,
             press_pixel: pixel,
             grab,
+            replan,
             events: 0,
             busy: Duration::ZERO,
             last: Duration::ZERO,
@@ -538,7 +553,7 @@ impl EditorState {
         let Some(drag) = &self.drag else {
             return Ok(());
         };
-        let target = self.drag_target(drag.plan.start_position, drag.press_pixel, pixel);
+        let target = self.drag_target(drag.origin, drag.press_pixel, pixel);
         self.drag_to_target(target)
     }
 
@@ -548,6 +563,32 @@ impl EditorState {
             return Ok(());
         };
         let started = Instant::now();
+        // A grab brush plans anew each `step` of the way (see `Replan`).
+        while let Some(replan) = &mut drag.replan {
+            let delta = target - drag.plan.start_position;
+            let normal = drag.plan.start_normal;
+            let along = (delta - normal * delta.dot(&normal)).norm();
+            // (No normal where the surface is degenerate: no plan anew.)
+            if along <= replan.step || !along.is_finite() {
+                break;
+            }
+            let via = drag.plan.start_position + delta * (replan.step / along);
+            drag.plan.drag_to(&mut self.surface, via)?;
+            // The old plan's vertices exact (the GPU drew them from its gains), the brush's
+            // samples where the surface now is, and the next plan from here.
+            self.mesh.rows_changed(&self.surface, &drag.plan.rows);
+            self.mesh.refresh_brush_weights(&self.surface)?;
+            let point = drag.plan.point;
+            drag.plan = DragPlan::new(
+                &self.surface,
+                &mut self.mesh,
+                point,
+                &replan.pins,
+                Some(replan.brush),
+                &replan.images,
+            )?;
+            replan.count += 1;
+        }
         drag.plan.drag_to(&mut self.surface, target)?;
         let took = started.elapsed();
         drag.events += 1;
@@ -584,16 +625,12 @@ impl EditorState {
             return;
         };
         let plan = drag.plan;
-        let moved: Vec<ControlId> = plan
-            .touched
-            .iter()
-            .copied()
-            .filter(|&c| self.control()[c.index()] != plan.start_control[c.index()])
-            .collect();
+        let moved = changed_since(self.control(), &drag.origin_control);
+        // The plans before the last left their vertices exact.
         self.mesh.rows_changed(&self.surface, &plan.rows);
         self.last_drag = Some(DragStats {
             point: plan.point,
-            start: plan.start_position,
+            start: drag.origin,
             target: plan.start_position + plan.displacement,
             events: drag.events,
             mean: drag.busy / drag.events.max(1),
@@ -613,7 +650,7 @@ impl EditorState {
             Change::Controls {
                 before: moved
                     .iter()
-                    .map(|&c| plan.start_control[c.index()])
+                    .map(|&c| drag.origin_control[c.index()])
                     .collect(),
                 after: moved.iter().map(|&c| self.control()[c.index()]).collect(),
                 indices: moved,
@@ -637,11 +674,16 @@ impl EditorState {
         let Some(drag) = self.drag.take() else {
             return;
         };
-        let start = &drag.plan.start_control;
-        let restored = drag.plan.touched.iter().map(|&c| (c, start[c.index()]));
+        let moved = changed_since(self.control(), &drag.origin_control);
+        let restored = moved.iter().map(|&c| (c, drag.origin_control[c.index()]));
         // The starting control points were valid, so restoring them cannot fail.
         if self.surface.set_control_points_at(restored).is_ok() {
-            self.mesh.rows_changed(&self.surface, &drag.plan.rows);
+            // The last plan's vertices (drawn from its gains) and every vertex the others moved.
+            let mut rows = self.mesh.rows_of_controls(&moved);
+            rows.extend_from_slice(&drag.plan.rows);
+            rows.sort_unstable();
+            rows.dedup();
+            self.mesh.rows_changed(&self.surface, &rows);
         }
     }
 
@@ -772,6 +814,14 @@ impl EditorState {
 
 /// How close (in pixels) a press must be to a pin to grab it.
 pub const PIN_RADIUS_PX: f64 = 7.0;
+
+/// The control points that differ from `origin`, in order.
+fn changed_since(control: &[Point3], origin: &[Point3]) -> Vec<ControlId> {
+    (0..control.len())
+        .filter(|&c| control[c] != origin[c])
+        .map(|c| ControlId(c as u32))
+        .collect()
+}
 
 fn check_meshing(meshing: Meshing) -> Result<(), EditorError> {
     match meshing {

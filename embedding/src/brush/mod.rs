@@ -505,6 +505,13 @@ impl Reach {
             .len()
             .div_ceil(SAMPLES_PER_CONTROL * controls.len())
             .max(1);
+        // Below the samples' spacing (the disc holds hundreds of them; samples in one cell are
+        // taken or left together), far above how well a surface edited by earlier solves is
+        // still mirror-symmetric (to about 1e-9 of its size), so mirror pairs rarely straddle a
+        // cell's edge. A quantum of 2⁻³⁰ units, near that, thinned the two sides of a sphere
+        // differently once a grab had planned anew (2e-4 of its size apart), R/2¹⁶ still did
+        // (9e-6).
+        let quantum = radius / 256.0;
         // Each control point's column among the moving ones (u32::MAX: held), by look-up: a
         // binary search per stencil entry took as long as the rest of the dab's fit.
         let mut columns_of = vec![u32::MAX; layout.control_count()];
@@ -517,7 +524,8 @@ impl Reach {
                 .iter()
                 .copied()
                 .filter(|&r| {
-                    stride == 1 || mirror_hash(positions[r as usize]).is_multiple_of(stride as u64)
+                    stride == 1
+                        || mirror_hash(positions[r as usize], quantum).is_multiple_of(stride as u64)
                 })
                 .collect(),
             inside,
@@ -776,12 +784,12 @@ impl Target for Vector3 {
     }
 }
 
-/// A hash of a point's coordinates' magnitudes (to 2⁻³⁰ of a unit, well above rounding, far below
-/// vertex spacing): the same for a point and its mirror images.
-fn mirror_hash(p: Point3) -> u64 {
+/// A hash of a point's coordinates' magnitudes, each rounded to a multiple of `quantum`: the same
+/// for a point and its mirror images, as long as they are mirror images to well within it.
+fn mirror_hash(p: Point3, quantum: f64) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for x in p.iter() {
-        let q = (x.abs() * (1u64 << 30) as f64).round() as u64;
+        let q = (x.abs() / quantum).round() as u64;
         h = (h ^ q).wrapping_mul(0x0000_0100_0000_01b3);
         h ^= h >> 29;
     }
