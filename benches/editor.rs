@@ -240,10 +240,6 @@ fn stroke_steps(
             "a {} brush of radius {radius:.3} (5% of the area {area:.2}) at {n} vertices",
             kind.name()
         );
-        // A stroke is begun anew (untimed, its changes undone) every STROKE dabs, so the surface
-        // stays near the model: hundreds of inflate dabs in one place would blow it up, and the
-        // brush would then cover a small part of it.
-        const STROKE: u32 = 8;
         let (mut flip, mut dabs, mut moved) = (false, 0u32, 0usize);
         group.bench_function(
             BenchmarkId::new(format!("stroke_step_{}", kind.name()), n),
@@ -251,16 +247,9 @@ fn stroke_steps(
                 b.iter_custom(|iters| {
                     let mut total = std::time::Duration::ZERO;
                     for _ in 0..iters {
-                        if state.stroke().is_none_or(|s| s.dabs >= STROKE) {
-                            state.cancel_drag();
-                            state.start_stroke(point).unwrap();
-                            flip = false;
-                        }
-                        flip = !flip;
+                        let (at, _) = next_dab(state, [point, other], &mut flip);
                         let started = std::time::Instant::now();
-                        state
-                            .stroke_at(black_box(if flip { other } else { point }))
-                            .unwrap();
+                        state.stroke_at(black_box(at)).unwrap();
                         total += started.elapsed();
                         dabs += 1;
                         moved += state.stroke().map_or(0, |s| s.last_moved);
@@ -269,30 +258,27 @@ fn stroke_steps(
                 })
             },
         );
-        {
-            // The editor picks the surface point under the pointer before every dab: the first
-            // pick after a dab refits the picking boxes of the vertices it moved.
-            let name = format!("pick_after_dab_{}", kind.name());
-            group.bench_function(BenchmarkId::new(name, n), |b| {
-                b.iter_custom(|iters| {
-                    let mut total = std::time::Duration::ZERO;
-                    for _ in 0..iters {
-                        if state.stroke().is_none_or(|s| s.dabs >= STROKE) {
-                            state.cancel_drag();
-                            state.start_stroke(point).unwrap();
-                            state.pick([400.0, 300.0]);
-                            flip = false;
-                        }
-                        flip = !flip;
-                        state.stroke_at(if flip { other } else { point }).unwrap();
-                        let started = std::time::Instant::now();
-                        black_box(state.pick(black_box([400.0, 300.0])));
-                        total += started.elapsed();
+        // The editor picks the surface point under the pointer before every dab: after a dab the
+        // ray meets the picking boxes grown by how far the dabs moved the vertices, or refitted
+        // once that is 1% of the size.
+        let name = format!("pick_after_dab_{}", kind.name());
+        group.bench_function(BenchmarkId::new(name, n), |b| {
+            b.iter_custom(|iters| {
+                let mut total = std::time::Duration::ZERO;
+                for _ in 0..iters {
+                    let (at, restarted) = next_dab(state, [point, other], &mut flip);
+                    if restarted {
+                        // The restart's undo moved vertices by any amount: a refit, untimed.
+                        state.pick([400.0, 300.0]);
                     }
-                    total
-                })
-            });
-        }
+                    state.stroke_at(at).unwrap();
+                    let started = std::time::Instant::now();
+                    black_box(state.pick(black_box([400.0, 300.0])));
+                    total += started.elapsed();
+                }
+                total
+            })
+        });
         if dabs > 0 {
             println!(
                 "{}: {dabs} dabs, {:.0} control points moved on average",
@@ -303,6 +289,26 @@ fn stroke_steps(
         state.cancel_drag();
     }
     state.brush = BrushKind::Grab;
+}
+
+/// The point of a stroke's next dab, alternating between `points` (so every dab is due), and
+/// whether the stroke was begun anew for it: every `STROKE` dabs (untimed, its changes undone), so
+/// the surface stays near the model (hundreds of inflate dabs in one place would blow it up, and
+/// the brush would then cover a small part of it).
+fn next_dab(
+    state: &mut EditorState,
+    points: [charts::ChartPoint; 2],
+    flip: &mut bool,
+) -> (charts::ChartPoint, bool) {
+    const STROKE: u32 = 8;
+    let restart = state.stroke().is_none_or(|s| s.dabs >= STROKE);
+    if restart {
+        state.cancel_drag();
+        state.start_stroke(points[0]).unwrap();
+        *flip = false;
+    }
+    *flip = !*flip;
+    (points[usize::from(*flip)], restart)
 }
 
 criterion_group!(benches, drag);
