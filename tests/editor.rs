@@ -1657,6 +1657,23 @@ fn a_long_grab_along_the_surface_does_not_fold_it() {
             .drag()
             .and_then(|d| d.replan.as_ref())
             .map_or(0, |r| r.count);
+        // Mid-drag, what the GPU is given: the vertices no plan holds now (the earlier plans'
+        // among them) where the surface is, to f32; the current plan's follow its gains.
+        let mesh = state.mesh();
+        let shown = mesh
+            .vertices()
+            .iter()
+            .zip(&mesh.tessellation.vertices)
+            .filter(|(v, _)| v.flags == 0)
+            .map(|(v, &p)| {
+                (Point3::from(v.position.map(f64::from)) - state.surface_point(p)).norm()
+            })
+            .fold(0.0, f64::max);
+        println!("mid-drag, the shown vertices no plan holds are within {shown:e} of the surface");
+        assert!(
+            shown < 1e-5 * size,
+            "a shown vertex is {shown:e} off the surface"
+        );
         if cancel {
             state.cancel_drag();
             assert_eq!(

@@ -79,6 +79,9 @@ pub struct Replan {
     pub images: Vec<(ChartPoint, Vector3)>,
     /// Plans made after the first.
     pub count: u32,
+    /// The vertices of the plans before the current one (increasing): their f64 positions and
+    /// tangents are brought up to date at the release.
+    pub settled: Vec<u32>,
 }
 
 /// A grab brush's plan carries the point this fraction of the radius (see [`Replan`]): the
@@ -252,12 +255,18 @@ impl DragPlan {
         for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
             beta[c.index()] = b;
         }
-        let (stencil, positions, tangents) = (mesh.stencil(), mesh.positions(), mesh.tangents());
+        // The rows' positions and tangents come from the same stencil rows, not from the mesh:
+        // a grab that plans anew leaves the f64 copies of its earlier plans' vertices for its
+        // release to bring up to date.
+        let stencil = mesh.stencil();
         plan.moves = vec![DragRow::default(); plan.rows.len()];
         parallel_chunks(&plan.rows, &mut plan.moves, |rows, out| {
             for (o, &r) in out.iter_mut().zip(rows) {
-                let mut g = [0.0f64; 9];
+                let (mut g, mut base) = ([0.0f64; 9], [Vector3::zeros(); 3]);
                 for (c, w) in stencil.row(r as usize) {
+                    for a in 0..3 {
+                        base[a] += control[c as usize].coords * w[a];
+                    }
                     let b = beta[c as usize];
                     if b != Vector3::zeros() {
                         for a in 0..3 {
@@ -267,7 +276,7 @@ impl DragPlan {
                         }
                     }
                 }
-                let (p, [u, v]) = (positions[r as usize], tangents[r as usize]);
+                let [p, u, v] = base;
                 *o = DragRow {
                     base: [p.x, p.y, p.z, u.x, u.y, u.z, v.x, v.y, v.z].map(|x| x as f32),
                     gain: g.map(|x| x as f32),
@@ -353,6 +362,18 @@ impl DragPlan {
         self.displacement = delta;
         self.residual = residual;
         Ok(residual)
+    }
+
+    /// Ends this plan's hold on its vertices as its last event left them: their GPU copies
+    /// written (no longer following the drag) and marked for upload. Their f64 positions and
+    /// tangents are not: [`LiveMesh::rows_changed`] with [`DragPlan::rows`] brings them up to date.
+    pub fn settle(&self, mesh: &mut LiveMesh) {
+        let vertices = mesh.vertices_mut();
+        self.move_vertices(self.displacement, vertices);
+        for &r in &self.rows {
+            vertices[r as usize].flags = 0;
+        }
+        mesh.mark_dirty(&self.rows);
     }
 
     /// The vertices' positions and normals for displacement `delta`, written into a vertex array on

@@ -286,6 +286,14 @@ impl LiveMesh {
         self.size = (hi - lo).norm();
     }
 
+    /// After `controls` moved: the brush samples they reach, exactly (the rest of the mesh is the
+    /// caller's to update).
+    pub fn brush_controls_moved(&mut self, surface: &Surface, controls: &[ControlId]) {
+        if let Some(samples) = &mut self.samples {
+            samples.controls_moved(surface, controls);
+        }
+    }
+
     /// The surface as a brush samples it (as of the last [`LiveMesh::refresh_brush_weights`] and
     /// the dabs since; made now if there are no samples for `surface` yet).
     pub fn brush_samples<'a>(

@@ -454,6 +454,7 @@ impl EditorState {
                 brush,
                 images,
                 count: 0,
+                settled: Vec::new(),
             }),
             _ => None,
         };
@@ -574,10 +575,12 @@ impl EditorState {
             }
             let via = drag.plan.start_position + delta * (replan.step / along);
             drag.plan.drag_to(&mut self.surface, via)?;
-            // The old plan's vertices exact (the GPU drew them from its gains), the brush's
-            // samples where the surface now is, and the next plan from here.
-            self.mesh.rows_changed(&self.surface, &drag.plan.rows);
-            self.mesh.refresh_brush_weights(&self.surface)?;
+            // The old plan's vertices as its gains put them (the f64 copies at the release), the
+            // brush's samples where the surface now is, and the next plan from here.
+            drag.plan.settle(&mut self.mesh);
+            replan.settled = merge_sorted(&replan.settled, &drag.plan.rows);
+            self.mesh
+                .brush_controls_moved(&self.surface, &drag.plan.touched);
             let point = drag.plan.point;
             drag.plan = DragPlan::new(
                 &self.surface,
@@ -626,8 +629,9 @@ impl EditorState {
         };
         let plan = drag.plan;
         let moved = changed_since(self.control(), &drag.origin_control);
-        // The plans before the last left their vertices exact.
-        self.mesh.rows_changed(&self.surface, &plan.rows);
+        let settled = drag.replan.map(|r| r.settled).unwrap_or_default();
+        self.mesh
+            .rows_changed(&self.surface, &merge_sorted(&settled, &plan.rows));
         self.last_drag = Some(DragStats {
             point: plan.point,
             start: drag.origin,
@@ -814,6 +818,24 @@ impl EditorState {
 
 /// How close (in pixels) a press must be to a pin to grab it.
 pub const PIN_RADIUS_PX: f64 = 7.0;
+
+/// The union of two increasing lists, increasing.
+fn merge_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() || j < b.len() {
+        let next = match (a.get(i), b.get(j)) {
+            (Some(&x), Some(&y)) if x <= y => x,
+            (_, Some(&y)) => y,
+            (Some(&x), None) => x,
+            (None, None) => unreachable!("one list has more"),
+        };
+        i += usize::from(a.get(i) == Some(&next));
+        j += usize::from(b.get(j) == Some(&next));
+        out.push(next);
+    }
+    out
+}
 
 /// The control points that differ from `origin`, in order.
 fn changed_since(control: &[Point3], origin: &[Point3]) -> Vec<ControlId> {
