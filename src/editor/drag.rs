@@ -150,7 +150,9 @@ pub struct DragPlan {
 impl DragPlan {
     /// Plans a drag of `point` with `pins` held, from the current control points; `brush` is the
     /// influence radius in model units and its falloff (None: the paper's edit); `images` are the
-    /// point's mirror images on the surface with the signs that mirror a displacement for them.
+    /// point's mirror images on the surface with the signs that mirror a displacement for them;
+    /// `settled` the vertices whose f64 positions in `mesh` are not up to date (a grab's earlier
+    /// plans').
     pub fn new(
         surface: &Surface,
         mesh: &mut LiveMesh,
@@ -158,6 +160,7 @@ impl DragPlan {
         pins: &[ChartPoint],
         brush: Option<(f64, Falloff)>,
         images: &[(ChartPoint, Vector3)],
+        settled: &[u32],
     ) -> Result<DragPlan, EmbeddingError> {
         let layout = &surface.layout();
         let control = surface.control_points();
@@ -255,17 +258,32 @@ impl DragPlan {
         for (&c, &b) in plan.touched.iter().zip(&plan.beta) {
             beta[c.index()] = b;
         }
-        // The rows' positions and tangents come from the same stencil rows, not from the mesh:
-        // a grab that plans anew leaves the f64 copies of its earlier plans' vertices for its
-        // release to bring up to date.
-        let stencil = mesh.stencil();
+        // The rows' positions and tangents: the mesh's, except for the vertices of a grab's
+        // earlier plans (`settled`: their f64 copies wait for the release), which come from the
+        // stencil rows streamed here anyway.
+        let mut stale = Vec::new();
+        if !settled.is_empty() {
+            stale = vec![0u64; mesh.vertex_count().div_ceil(64)];
+            for &r in settled {
+                stale[r as usize / 64] |= 1 << (r % 64);
+            }
+        }
+        let is_stale = |r: u32| {
+            stale
+                .get(r as usize / 64)
+                .is_some_and(|w| w & (1 << (r % 64)) != 0)
+        };
+        let (stencil, positions, tangents) = (mesh.stencil(), mesh.positions(), mesh.tangents());
         plan.moves = vec![DragRow::default(); plan.rows.len()];
         parallel_chunks(&plan.rows, &mut plan.moves, |rows, out| {
             for (o, &r) in out.iter_mut().zip(rows) {
+                let stale = is_stale(r);
                 let (mut g, mut base) = ([0.0f64; 9], [Vector3::zeros(); 3]);
                 for (c, w) in stencil.row(r as usize) {
-                    for a in 0..3 {
-                        base[a] += control[c as usize].coords * w[a];
+                    if stale {
+                        for a in 0..3 {
+                            base[a] += control[c as usize].coords * w[a];
+                        }
                     }
                     let b = beta[c as usize];
                     if b != Vector3::zeros() {
@@ -275,6 +293,10 @@ impl DragPlan {
                             }
                         }
                     }
+                }
+                if !stale {
+                    let [u, v] = tangents[r as usize];
+                    base = [positions[r as usize].coords, u, v];
                 }
                 let [p, u, v] = base;
                 *o = DragRow {

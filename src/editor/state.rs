@@ -446,7 +446,15 @@ impl EditorState {
             Grab::Surface => self.mirror_images(point),
             Grab::Pin(_) => Vec::new(),
         };
-        let plan = DragPlan::new(&self.surface, &mut self.mesh, point, &pins, brush, &images)?;
+        let plan = DragPlan::new(
+            &self.surface,
+            &mut self.mesh,
+            point,
+            &pins,
+            brush,
+            &images,
+            &[],
+        )?;
         let replan = match (grab, brush) {
             (Grab::Surface, Some(brush)) => Some(Replan {
                 step: REPLAN * brush.0,
@@ -589,6 +597,7 @@ impl EditorState {
                 &replan.pins,
                 Some(replan.brush),
                 &replan.images,
+                &replan.settled,
             )?;
             replan.count += 1;
         }
