@@ -742,7 +742,7 @@ proptest! {
         let displaced: Vec<(u32, Vector3)> = moved.iter().map(|&c| (c, step)).collect();
         let (mut updated, mut updated_tangents) = (positions.clone(), tangents.clone());
         let mut lag = vec![0f32; n];
-        let rows = tensor.follow_controls(
+        let followed = tensor.follow_controls(
             &after,
             &displaced,
             0.0,
@@ -751,7 +751,18 @@ proptest! {
             &mut updated_tangents,
             |p, t, position, tangents| (*p, *t) = (position, tangents),
         );
+        let rows = followed.rows;
         prop_assert!(rows.windows(2).all(|w| w[0] < w[1]));
+        // Every moved point moved the same way, so the bound is the motion itself: the largest
+        // lag reported is how far the row that moved most went.
+        let farthest = rows
+            .iter()
+            .map(|&r| (updated[r as usize] - positions[r as usize]).norm())
+            .fold(0.0, f64::max);
+        prop_assert!(
+            (followed.largest_lag - farthest).abs() <= 1e-5 * farthest + 1e-6 * diagonal,
+            "largest lag {:e}, farthest {:e}", followed.largest_lag, farthest
+        );
         prop_assert!(lag.iter().all(|&l| l == 0.0));
         let mut fresh = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
         tensor.positions_and_tangents(&after, &mut fresh.0, &mut fresh.1);
@@ -783,7 +794,8 @@ proptest! {
             for &(c, d) in &displaced {
                 now[c as usize] += d;
             }
-            let rows = tensor.follow_controls(
+            let written = updated.clone();
+            let followed = tensor.follow_controls(
                 &now,
                 &displaced,
                 threshold,
@@ -792,6 +804,12 @@ proptest! {
                 &mut updated_tangents,
                 |p, t, position, tangents| (*p, *t) = (position, tangents),
             );
+            let rows = followed.rows;
+            // An evaluated row moved by no more than the largest lag reported.
+            for &r in &rows {
+                let moved = (updated[r as usize] - written[r as usize]).norm();
+                prop_assert!(moved <= followed.largest_lag * (1.0 + 1e-5) + 1e-6 * diagonal, "row {}: moved {:e}, largest lag {:e}", r, moved, followed.largest_lag);
+            }
             tensor.positions_and_tangents(&now, &mut fresh.0, &mut fresh.1);
             for r in 0..n {
                 prop_assert!(f64::from(lag[r]) < threshold, "row {}: lag {} at or over the threshold", r, lag[r]);

@@ -8,7 +8,6 @@
 //! barycentric coordinates.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use bytemuck::{Pod, Zeroable};
 use charts::{ChartId, ChartPoint};
@@ -189,8 +188,9 @@ pub const UNSEEN: f64 = 1e-4;
 const HELD_BACK: f64 = 0.5;
 
 /// During a stroke the picking boxes are refitted once the vertices may have left them by this
-/// fraction of the model's size; until then a ray is cast against the boxes grown by how far
-/// (a ray then meets a few hundred more triangles' boxes at 10⁶ vertices).
+/// fraction of the model's size (a bound from the rows' lags); until then a ray is cast against
+/// the boxes grown by how far (a ray then meets a few hundred more triangles' boxes at 10⁶
+/// vertices).
 const SLACK: f64 = 0.01;
 
 /// The live surface mesh (see the module documentation).
@@ -495,8 +495,7 @@ impl LiveMesh {
         // The vertex and its f64 position are written; the f64 tangents are left as they were
         // (nothing reads them during a stroke, and its end makes them exact again): bytes a
         // vertex need not move.
-        let farthest = AtomicU64::new(0);
-        let rows = tensor.follow_controls(
+        let followed = tensor.follow_controls(
             surface.control_points(),
             &due,
             (1.0 - HELD_BACK) * seen,
@@ -505,22 +504,19 @@ impl LiveMesh {
             &mut self.vertices,
             |position, vertex, p, [u, v]| {
                 let n = u.cross(&v).normalize();
-                // Non-negative floats order as their bits do. Loaded first: the largest is soon
-                // found, and then the cores only read the shared word.
-                let moved = (p - *position).norm().to_bits();
-                if moved > farthest.load(Ordering::Relaxed) {
-                    farthest.fetch_max(moved, Ordering::Relaxed);
-                }
                 *position = p;
                 vertex.position = [p.x as f32, p.y as f32, p.z as f32];
                 vertex.normal = [n.x as f32, n.y as f32, n.z as f32];
                 vertex.flags = 0;
             },
         );
-        if !rows.is_empty() {
-            self.dirty.add_sorted(&rows);
-            let farthest = f64::from_bits(farthest.into_inner());
-            self.unfitted.add(&rows, self.positions.len(), farthest);
+        if !followed.rows.is_empty() {
+            self.dirty.add_sorted(&followed.rows);
+            // How far a written vertex moved: at most its lag, with the motions held back when it
+            // was last evaluated and now (each under HELD_BACK of `seen`).
+            let moved = followed.largest_lag + 2.0 * HELD_BACK * seen;
+            self.unfitted
+                .add(&followed.rows, self.positions.len(), moved);
         }
     }
 

@@ -124,6 +124,15 @@ impl RowsByFirst {
     }
 }
 
+/// What [`TensorStencil::follow_controls`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Followed {
+    /// The rows evaluated anew, increasing.
+    pub rows: Vec<u32>,
+    /// The largest lag an evaluated row had.
+    pub largest_lag: f64,
+}
+
 /// f32 numbers per block that the tangents add, for B-spline order `order`.
 pub fn tangent_words(order: usize) -> usize {
     2 * order + 4
@@ -404,7 +413,7 @@ impl TensorStencil {
         first: &mut [A],
         second: &mut [B],
         write: impl Fn(&mut A, &mut B, Point3, [Vector3; 2]) + Sync,
-    ) -> Vec<u32> {
+    ) -> Followed {
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
         let rows = self.rows();
         let (lag, first, second) = (&mut lag[..rows], &mut first[..rows], &mut second[..rows]);
@@ -422,7 +431,8 @@ impl TensorStencil {
         let frame = ControlFrame::new(control);
         let threshold = threshold as f32;
         let order = self.order;
-        let follow = |r: usize, lag: &mut f32, a: &mut A, b: &mut B| -> bool {
+        // Some(the row's lag) where the row was evaluated.
+        let follow = |r: usize, lag: &mut f32, a: &mut A, b: &mut B| -> Option<f32> {
             *lag += match order {
                 2 => self.motion_bound::<2>(&motion, &windows, r),
                 3 => self.motion_bound::<3>(&motion, &windows, r),
@@ -433,7 +443,7 @@ impl TensorStencil {
                 _ => self.motion_bound::<8>(&motion, &windows, r),
             };
             if *lag < threshold {
-                return false;
+                return None;
             }
             let (p, t) = match order {
                 2 => self.row_jet::<2>(&frame, r),
@@ -445,12 +455,11 @@ impl TensorStencil {
                 _ => self.row_jet::<8>(&frame, r),
             };
             write(a, b, p, t);
-            *lag = 0.0;
-            true
+            Some(std::mem::take(lag))
         };
         // Each task takes a range of rows, finds those a moved window reaches there (a bit each)
         // and follows them in order.
-        let parts: Vec<Vec<u32>> = lag
+        let parts: Vec<(Vec<u32>, f32)> = lag
             .par_chunks_mut(FOLLOW_ROWS_PER_TASK)
             .zip(first.par_chunks_mut(FOLLOW_ROWS_PER_TASK))
             .zip(second.par_chunks_mut(FOLLOW_ROWS_PER_TASK))
@@ -458,17 +467,21 @@ impl TensorStencil {
             .map(|(t, ((lag, a), b))| {
                 let start = t * FOLLOW_ROWS_PER_TASK;
                 let reached = index.rows_between(&origins, start..start + lag.len());
-                super::set_bits(&reached)
-                    .into_iter()
-                    .filter(|&k| {
-                        let k = k as usize;
-                        follow(start + k, &mut lag[k], &mut a[k], &mut b[k])
-                    })
-                    .map(|k| (start + k as usize) as u32)
-                    .collect()
+                let (mut rows, mut largest) = (Vec::new(), 0f32);
+                for k in super::set_bits(&reached) {
+                    let k = k as usize;
+                    if let Some(l) = follow(start + k, &mut lag[k], &mut a[k], &mut b[k]) {
+                        rows.push((start + k) as u32);
+                        largest = largest.max(l);
+                    }
+                }
+                (rows, largest)
             })
             .collect();
-        parts.concat()
+        Followed {
+            largest_lag: f64::from(parts.iter().map(|p| p.1).fold(0.0, f32::max)),
+            rows: parts.into_iter().flat_map(|p| p.0).collect(),
+        }
     }
 
     /// Σ_c w_c |Δ_c| over row `r`'s blocks in a window marked in `windows`, `motion` holding
