@@ -466,9 +466,7 @@ impl LiveMesh {
     /// it.
     pub fn controls_moved(&mut self, surface: &Surface, moved: &[(ControlId, Vector3)]) {
         let controls: Vec<ControlId> = moved.iter().map(|m| m.0).collect();
-        if let Some(samples) = &mut self.samples {
-            samples.controls_moved(surface, &controls);
-        }
+        self.brush_controls_moved(surface, &controls);
         if matches!(self.style, Style::Curvature(_) | Style::Charts) {
             self.controls_changed(surface, &controls);
             return;

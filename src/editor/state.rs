@@ -691,12 +691,12 @@ impl EditorState {
         let restored = moved.iter().map(|&c| (c, drag.origin_control[c.index()]));
         // The starting control points were valid, so restoring them cannot fail.
         if self.surface.set_control_points_at(restored).is_ok() {
-            // The last plan's vertices (drawn from its gains) and every vertex the others moved.
-            let mut rows = self.mesh.rows_of_controls(&moved);
-            rows.extend_from_slice(&drag.plan.rows);
-            rows.sort_unstable();
-            rows.dedup();
-            self.mesh.rows_changed(&self.surface, &rows);
+            // Every vertex the moved points reach, the last plan's (drawn from its gains) and the
+            // earlier plans' (written from theirs).
+            let settled = drag.replan.map(|r| r.settled).unwrap_or_default();
+            let rows = merge_sorted(&self.mesh.rows_of_controls(&moved), &drag.plan.rows);
+            self.mesh
+                .rows_changed(&self.surface, &merge_sorted(&rows, &settled));
         }
     }
 

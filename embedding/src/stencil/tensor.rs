@@ -368,15 +368,7 @@ impl TensorStencil {
             .zip(out.par_chunks_mut(ROWS_PER_TASK))
             .for_each(|(rows, out)| {
                 for (o, &r) in out.iter_mut().zip(rows) {
-                    *o = match self.order {
-                        2 => self.row_jet::<2>(frame, r as usize),
-                        3 => self.row_jet::<3>(frame, r as usize),
-                        4 => self.row_jet::<4>(frame, r as usize),
-                        5 => self.row_jet::<5>(frame, r as usize),
-                        6 => self.row_jet::<6>(frame, r as usize),
-                        7 => self.row_jet::<7>(frame, r as usize),
-                        _ => self.row_jet::<8>(frame, r as usize),
-                    };
+                    *o = self.row_jet_of_order(frame, r as usize);
                 }
             });
     }
@@ -389,10 +381,9 @@ impl TensorStencil {
     /// `first` and `second`) and its lag set to 0. On all cores; returns the rows evaluated, in
     /// increasing order. A `threshold` of 0 evaluates every row that uses a moved point.
     ///
-    /// The bound: a row's weights w_c are positive, so its point moves by at most Σ_c w_c |Δ_c|.
-    /// Most rows
-    /// a dab reaches lie at its fringe and move very little; those are only bounded (Σ_c w_c |Δ_c|
-    /// from the position factors alone, in scalars), not evaluated.
+    /// The bound: a row's weights w_c are positive, so its point moves by at most Σ_c w_c |Δ_c|,
+    /// formed from the position factors alone, in scalars. Most rows a dab reaches lie at its
+    /// fringe and move very little; those are only bounded, not evaluated.
     ///
     /// Finding the rows: a block uses the order × order window of its chart's grid from its first
     /// control point, so the rows are those listed under the windows that hold a moved point (an
@@ -445,15 +436,7 @@ impl TensorStencil {
             if *lag < threshold {
                 return None;
             }
-            let (p, t) = match order {
-                2 => self.row_jet::<2>(&frame, r),
-                3 => self.row_jet::<3>(&frame, r),
-                4 => self.row_jet::<4>(&frame, r),
-                5 => self.row_jet::<5>(&frame, r),
-                6 => self.row_jet::<6>(&frame, r),
-                7 => self.row_jet::<7>(&frame, r),
-                _ => self.row_jet::<8>(&frame, r),
-            };
+            let (p, t) = self.row_jet_of_order(&frame, r);
             write(a, b, p, t);
             Some(std::mem::take(lag))
         };
@@ -502,6 +485,19 @@ impl TensorStencil {
             }
         }
         bound
+    }
+
+    /// [`TensorStencil::row_jet`] for this stencil's order.
+    fn row_jet_of_order(&self, frame: &ControlFrame, r: usize) -> (Point3, [Vector3; 2]) {
+        match self.order {
+            2 => self.row_jet::<2>(frame, r),
+            3 => self.row_jet::<3>(frame, r),
+            4 => self.row_jet::<4>(frame, r),
+            5 => self.row_jet::<5>(frame, r),
+            6 => self.row_jet::<6>(frame, r),
+            7 => self.row_jet::<7>(frame, r),
+            _ => self.row_jet::<8>(frame, r),
+        }
     }
 
     /// One row of [`TensorStencil::tangent_kernel`] (by the cubic AVX kernel where it runs).
