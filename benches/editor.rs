@@ -14,7 +14,12 @@
 //! - `brush_start` and `brush_event`: the same with an influence radius of 15% (a grab brush:
 //!   planning adds the least-squares shares of the falloff field);
 //! - `brush_replan_event`: an event that carries the grabbed point a quarter of the radius or more
-//!   along the surface, so the grab plans anew from there (see `editor::drag::Replan`);
+//!   along the surface, so the grab plans anew from there (see `editor::drag::Replan`), the plan
+//!   made in the event (as `ntori sculpt` does);
+//! - `brush_replan_background_{dispatch,job,install}`: the same with the plan made on a thread of
+//!   its own, as the editor's window does (`editor::drag::PlanJob`): the event that starts it
+//!   (the last plan serves it), the time until the plan is made (from that event's start), and
+//!   the next event, which puts it in place;
 //! - `stroke_step_inflate`, `_smooth`, `_flatten`: one step of a stroke (a dab: the brush's fit,
 //!   the new control points and the vertices they reach, within `UNSEEN` of the surface) of a
 //!   brush whose disc covers 5% of the surface's area;
@@ -52,6 +57,68 @@ fn setup(model: &Surface, t: u32) -> (EditorState, charts::ChartPoint) {
         state.add_pin(p);
     }
     (state, dragged)
+}
+
+/// Which part of a plan made in the background to time.
+#[derive(Clone, Copy)]
+enum Part {
+    Dispatch,
+    Job,
+    Install,
+}
+
+impl Part {
+    fn name(self) -> &'static str {
+        match self {
+            Part::Dispatch => "dispatch",
+            Part::Job => "job",
+            Part::Install => "install",
+        }
+    }
+}
+
+/// One grab brush that carries the point 0.3 R along the surface with its next plan made in the
+/// background, then a little further: the time `part` took.
+fn replan_in_background(
+    state: &mut EditorState,
+    point: charts::ChartPoint,
+    part: Part,
+) -> std::time::Duration {
+    state.plan_in_background = true;
+    state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+    let plan = &state.drag().expect("a drag").plan;
+    let normal = plan.start_normal;
+    let side = normal.cross(&Vector3::new(0.6, 0.8, 0.0)).normalize();
+    let to = plan.start_position + side * (0.3 * state.radius());
+    let started = std::time::Instant::now();
+    state.drag_to_target(black_box(to)).unwrap();
+    let dispatch = started.elapsed();
+    let job = || {
+        state
+            .drag()
+            .and_then(|d| d.replan.as_ref())
+            .and_then(|r| r.job.as_ref())
+            .is_some_and(|j| !j.is_finished())
+    };
+    while job() {
+        std::thread::yield_now();
+    }
+    let made = started.elapsed();
+    let started = std::time::Instant::now();
+    state.drag_to_target(black_box(to + side * 1e-3)).unwrap();
+    let install = started.elapsed();
+    let plans = state
+        .drag()
+        .and_then(|d| d.replan.as_ref())
+        .map(|r| r.count);
+    assert_eq!(plans, Some(1), "the plan is in place");
+    state.cancel_drag();
+    state.plan_in_background = false;
+    match part {
+        Part::Dispatch => dispatch,
+        Part::Job => made,
+        Part::Install => install,
+    }
 }
 
 fn drag(c: &mut Criterion) {
@@ -177,6 +244,16 @@ fn drag(c: &mut Criterion) {
                 total
             })
         });
+        for part in [Part::Dispatch, Part::Job, Part::Install] {
+            let name = format!("brush_replan_background_{}", part.name());
+            group.bench_function(BenchmarkId::new(name, n), |b| {
+                b.iter_custom(|iters| {
+                    (0..iters)
+                        .map(|_| replan_in_background(&mut state, point, part))
+                        .sum()
+                })
+            });
+        }
         // The drags above left their releases in the surface: strokes start from the model.
         let (mut fresh, point) = setup(&model, t);
         stroke_steps(&mut group, &mut fresh, point, n);

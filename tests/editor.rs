@@ -293,7 +293,7 @@ fn a_drag_moves_the_point_to_the_cursor_pins_stay_and_undo_redo_are_exact() {
     assert_ne!(before, after);
     assert!(state.is_modified());
     // The drag's vertex update (p0 + gΔ, tangents likewise) agrees with the exact rows.
-    for &r in &rows {
+    for &r in rows.iter() {
         let v = reference[r as usize];
         let exact = mesh.positions()[r as usize];
         let p = Point3::new(
@@ -1717,6 +1717,107 @@ fn a_long_grab_along_the_surface_does_not_fold_it() {
             "the undo restores every control point"
         );
     }
+}
+
+/// A grab brush that makes its plans in the background (as the editor's window does) ends where
+/// one that makes each plan when due does, whenever each plan is put in place: waiting for every
+/// plan after each event gives the same control points and the same GPU vertices, bit for bit;
+/// not waiting (0.8 R along the surface), the drag still reaches the pointer without folding,
+/// the release leaves every vertex exact and the mesh the editor's alone, and one undo step
+/// takes it all back.
+#[test]
+fn a_grab_planning_in_the_background_ends_as_one_planning_when_due() {
+    let mut due = brush_state();
+    let mut waited = brush_state();
+    waited.plan_in_background = true;
+    let size = due.size();
+    let original = due.control().to_vec();
+    let point = top_point(&due, 0.3 * size);
+    let at = due.surface_point(point);
+    for state in [&mut due, &mut waited] {
+        state.influence = 0.12;
+        state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+    }
+    let radius = due.radius();
+    // Uneven steps, one of them well past where the last plan serves (that event waits).
+    let steps = [0.1, 0.15, 0.3, 0.37, 0.45, 1.2, 1.25, 1.4];
+    for (k, &s) in steps.iter().enumerate() {
+        let to = at + Vector3::new(0.0, s * radius, 0.02 * k as f64 * radius);
+        due.drag_to_target(to).unwrap();
+        waited.drag_to_target(to).unwrap();
+        waited.finish_plan();
+        assert!(!waited.mesh().is_lent(), "the plan is in place");
+        assert_eq!(due.control(), waited.control(), "event {k}: control points");
+        assert!(
+            due.mesh().vertices() == waited.mesh().vertices(),
+            "event {k}: GPU vertices"
+        );
+        let plans = |s: &EditorState| s.drag().and_then(|d| d.replan.as_ref()).map(|r| r.count);
+        assert_eq!(plans(&due), plans(&waited), "event {k}: plans");
+    }
+    let plans = due
+        .drag()
+        .and_then(|d| d.replan.as_ref())
+        .map_or(0, |r| r.count);
+    assert!(plans >= 4, "the grab planned anew as it went: {plans}");
+
+    // Not waiting: plans are put in place whenever they are made.
+    let mut free = brush_state();
+    free.plan_in_background = true;
+    free.influence = 0.12;
+    free.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+    let end = at + Vector3::new(0.0, 0.8 * radius, 0.0);
+    for k in 1..=32 {
+        let to = at + Vector3::new(0.0, 0.025 * f64::from(k) * radius, 0.0);
+        free.drag_to_target(to).unwrap();
+    }
+    let plans = free
+        .drag()
+        .and_then(|d| d.replan.as_ref())
+        .map_or(0, |r| r.count);
+    free.release();
+    println!("not waiting: {plans} plans after the first were in place before the release");
+    let mesh = free.mesh();
+    assert!(!mesh.is_lent(), "the release waits for the plan");
+    let mut exact = vec![Point3::origin(); mesh.vertex_count()];
+    mesh.stencil().positions(free.control(), &mut exact);
+    let off = mesh
+        .positions()
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(
+        off <= 1e-12 * size,
+        "a vertex is {off:e} off after the release"
+    );
+    let shown = mesh
+        .vertices()
+        .iter()
+        .zip(&exact)
+        .map(|(v, b)| (Point3::from(v.position.map(f64::from)) - b).norm())
+        .fold(0.0, f64::max);
+    assert!(shown < 1e-5 * size, "a GPU vertex is {shown:e} off");
+    assert!(
+        mesh.vertices().iter().all(|v| v.flags == 0),
+        "no vertex follows a plan"
+    );
+    let reached = (free.surface_point(point) - end).norm();
+    assert!(
+        reached < 1e-6 * size,
+        "the point reached the pointer: {reached:e} off"
+    );
+    let lowest = mesh
+        .positions()
+        .iter()
+        .zip(mesh.tangents())
+        .filter(|(p, _)| (**p - end).norm() < 2.0 * radius && p.z > at.z - 0.2 * radius)
+        .map(|(_, [u, v])| u.cross(v).normalize().z)
+        .fold(f64::INFINITY, f64::min);
+    println!("planning in the background: the normals near the point face up at least {lowest:.3}");
+    assert!(lowest > 0.0, "the top face turned over: {lowest:.3}");
+    free.undo().unwrap();
+    assert_eq!(free.control(), &original[..], "one undo step restores it");
 }
 
 /// With mirror symmetry the picked point's image, found on the surface, moves too, in the same

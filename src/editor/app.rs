@@ -38,6 +38,10 @@ pub struct EditorOptions {
     /// Native file dialogs (rfd) or the in-window path prompt; None: native where a desktop portal
     /// or zenity is there.
     pub native_dialogs: Option<bool>,
+    /// A grab brush makes its next plan on a thread of its own, so no drag event waits for one
+    /// (see [`EditorState::plan_in_background`]); off, each event's result depends on the
+    /// events alone.
+    pub plan_in_background: bool,
 }
 
 impl Default for EditorOptions {
@@ -50,6 +54,7 @@ impl Default for EditorOptions {
             exit_after_frames: None,
             screenshot_on_exit: None,
             native_dialogs: None,
+            plan_in_background: true,
         }
     }
 }
@@ -82,6 +87,8 @@ pub struct EditorApp {
     pub(super) pending_screenshot: Option<PathBuf>,
     /// The tessellation used when the first model arrives.
     meshing: Meshing,
+    /// Handed to every model shown ([`EditorOptions::plan_in_background`]).
+    plan_in_background: bool,
     smoke: SmokeTest,
     title: String,
 }
@@ -108,6 +115,7 @@ impl EditorApp {
             close_now: false,
             pending_screenshot: None,
             meshing: options.meshing,
+            plan_in_background: options.plan_in_background,
             smoke: SmokeTest {
                 frames: 0,
                 exit_after: options.exit_after_frames,
@@ -221,6 +229,7 @@ impl EditorApp {
 
     /// Shows `state` in place of the current model, in the same viewport.
     pub(super) fn install(&mut self, mut state: EditorState) {
+        state.plan_in_background = self.plan_in_background;
         state.viewport = self.state.as_ref().map_or([800.0, 600.0], |s| s.viewport);
         state.frame();
         self.panel.reset(state.settings());

@@ -24,16 +24,21 @@
 //! then the minimum-norm correction makes the dragged point and the pins exact again. The footprint
 //! is then the radius in every chart, whichever chart the point was picked in.
 
+use std::sync::Arc;
+use std::thread::JoinHandle;
 use std::time::Duration;
 
 use charts::ChartPoint;
+use embedding::brush::BrushSamples;
 use embedding::brush::{Falloff, grab_shares_mirrored};
 use embedding::edit::{Constraint, solve};
-use embedding::{ControlId, EmbeddingError, Layout, Point3, Surface, Vector3};
+use embedding::{
+    ColumnIndex, ControlId, EmbeddingError, Layout, Point3, Stencil, Surface, Vector3,
+};
 
 use bytemuck::{Pod, Zeroable};
 
-use super::mesh::{LiveMesh, ViewVertex};
+use super::mesh::{Lent, LiveMesh, ViewVertex};
 use embedding::evaluate::parallel_chunks;
 
 /// What a press in the viewport grabbed.
@@ -46,7 +51,7 @@ pub enum Grab {
 }
 
 /// A drag in progress: the plan and where the pointer went down.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Drag {
     pub plan: DragPlan,
     pub press_pixel: [f64; 2],
@@ -69,8 +74,10 @@ pub struct Drag {
 /// along the surface of about half the radius. So a grab brush plans anew, from where the surface
 /// then is, each time the point has travelled [`REPLAN`] of the radius along the surface since
 /// the last plan: the region follows the pointer a step at a time, each step a map that cannot
-/// fold, and a pull along the surface drags a smooth bump along instead of folding it.
-#[derive(Clone, Debug)]
+/// fold, and a pull along the surface drags a smooth bump along instead of folding it. (Pulled
+/// much further, about 1.4 R, the squeezed front does fold: each plan starts from the last one's
+/// squeeze.)
+#[derive(Debug)]
 pub struct Replan {
     /// How far the point travels along the surface under one plan (model units).
     pub step: f64,
@@ -80,14 +87,22 @@ pub struct Replan {
     /// Plans made after the first.
     pub count: u32,
     /// The vertices of the plans before the current one (increasing): their f64 positions and
-    /// tangents are brought up to date at the release.
+    /// tangents are brought up to date at the release. (Lent to `job` while it runs.)
     pub settled: Vec<u32>,
+    /// The next plan, being made on a thread of its own (see [`PlanJob`]).
+    pub job: Option<PlanJob>,
 }
 
 /// A grab brush's plan carries the point this fraction of the radius (see [`Replan`]): the
 /// smooth profile's steepest slope is 1.72, so one plan's map stretches the surface by at most
 /// 1 − 0.43 and cannot fold it.
 pub const REPLAN: f64 = 0.25;
+
+/// While the next plan is made in the background ([`PlanJob`]), the last one serves the events
+/// until the point has travelled this fraction of the radius from its start; then an event waits
+/// for the plan. The smooth and sharp profiles' steepest slopes are 1.72 and 2, so the map still
+/// keeps a fifth of the surface's length there.
+pub const SERVE: f64 = 0.4;
 
 /// The last finished drag: what moved where, and how long its events took.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,6 +129,171 @@ pub struct DragRow {
     pub gain: [f32; 9],
 }
 
+/// Where a plan starts: the dragged point, its position and unit normal, and its mirror images
+/// with their positions and the signs that mirror Δ for them.
+struct Start {
+    point: ChartPoint,
+    position: Point3,
+    normal: Vector3,
+    images: Vec<(ChartPoint, Point3, Vector3)>,
+}
+
+impl Start {
+    fn new(surface: &Surface, point: ChartPoint, images: &[(ChartPoint, Vector3)]) -> Start {
+        let layout = &surface.layout();
+        let control = surface.control_points();
+        let start = layout.eval(control, point);
+        Start {
+            point,
+            position: start.pos,
+            normal: start.normal(),
+            images: images
+                .iter()
+                .map(|&(p, signs)| (p, layout.eval(control, p).pos, signs))
+                .collect(),
+        }
+    }
+
+    /// A grab brush's shares of Δ per control point (none for the paper's edit), fitted over
+    /// the brush samples `samples` gives.
+    fn shares<'s>(
+        &self,
+        brush: Option<(f64, Falloff)>,
+        samples: impl FnOnce() -> Result<BrushSamples<'s>, EmbeddingError>,
+    ) -> Result<Vec<(ControlId, Vector3)>, EmbeddingError> {
+        match brush {
+            Some((radius, falloff)) if radius > 0.0 => {
+                let centres: Vec<(Point3, Vector3)> =
+                    std::iter::once((self.position, Vector3::new(1.0, 1.0, 1.0)))
+                        .chain(self.images.iter().map(|&(_, at, signs)| (at, signs)))
+                        .collect();
+                grab_shares_mirrored(&samples()?, &centres, radius, falloff)
+            }
+            _ => Ok(Vec::new()),
+        }
+    }
+}
+
+/// What a plan reads of the live mesh (or of what it lent): the stencil and its columns, and
+/// every vertex's f64 position and tangents.
+pub(crate) struct PlanRows<'a> {
+    pub stencil: &'a Stencil,
+    pub columns: &'a ColumnIndex,
+    pub positions: &'a [Point3],
+    pub tangents: &'a [[Vector3; 2]],
+}
+
+/// A grab brush's next plan, made on a thread of its own while the last plan goes on serving the
+/// events (a plan takes about 25 ms at 10⁵ vertices and 0.1 s at 10⁶: its rows' gains, the
+/// brush's shares), so that no drag event waits for one. The live mesh lends it what it reads and
+/// the vertices it writes ([`LiveMesh::lend`]): the thread brings the brush samples to where the
+/// last plan moved the surface, writes the last plan's vertices as it left them, and makes the
+/// plan from there.
+#[derive(Debug)]
+pub struct PlanJob {
+    handle: JoinHandle<PlanDone>,
+}
+
+/// What a [`PlanJob`] hands back.
+pub(crate) struct PlanDone {
+    pub plan: Result<DragPlan, EmbeddingError>,
+    pub lent: Lent,
+    /// The settled vertices with the last plan's.
+    pub settled: Vec<u32>,
+    /// The vertices written (the last plan's and the new one's), to upload.
+    pub written: Vec<u32>,
+}
+
+/// What the next plan is made from: the surface as the last plan left it at `via`, and the
+/// grab's pins, brush and mirror images.
+pub(crate) struct PlanFrom<'a> {
+    pub surface: &'a Surface,
+    pub via: Point3,
+    pub pins: &'a [ChartPoint],
+    pub brush: (f64, Falloff),
+    pub images: &'a [(ChartPoint, Vector3)],
+}
+
+impl PlanJob {
+    /// Starts making the plan that follows `last` from `from.via`; `settled` the vertices of
+    /// the plans before `last`. Fails (before starting anything) if the last plan cannot reach
+    /// `via`.
+    pub(crate) fn start(
+        last: &DragPlan,
+        from: PlanFrom<'_>,
+        mesh: &mut LiveMesh,
+        settled: Vec<u32>,
+    ) -> Result<PlanJob, EmbeddingError> {
+        let mut surface = from.surface.clone();
+        let delta = from.via - last.start_position;
+        let (updates, _) = last.controls_at(&surface.layout(), delta)?;
+        surface.set_control_points_at(updates)?;
+        let mut lent = mesh.lend(&surface)?;
+        let (rows, moves, touched) = (
+            Arc::clone(&last.rows),
+            Arc::clone(&last.moves),
+            last.touched.clone(),
+        );
+        let (point, pins, brush, images) = (
+            last.point,
+            from.pins.to_vec(),
+            from.brush,
+            from.images.to_vec(),
+        );
+        let handle = std::thread::Builder::new()
+            .name("ntori grab plan".into())
+            .spawn(move || {
+                lent.samples.controls_moved(&surface, &touched);
+                settle_rows(&rows, &moves, delta, &mut lent.vertices);
+                let settled = merge_sorted(&settled, &rows);
+                let plan = DragPlan::from_lent(
+                    &surface, &mut lent, point, &pins, brush, &images, &settled,
+                );
+                let written = match &plan {
+                    Ok(plan) => merge_sorted(&rows, &plan.rows),
+                    Err(_) => rows.to_vec(),
+                };
+                PlanDone {
+                    plan,
+                    lent,
+                    settled,
+                    written,
+                }
+            })
+            .expect("a thread for the grab's next plan");
+        Ok(PlanJob { handle })
+    }
+
+    pub fn is_finished(&self) -> bool {
+        self.handle.is_finished()
+    }
+
+    /// Waits for the plan (a panic on its thread goes on here).
+    pub(crate) fn join(self) -> PlanDone {
+        self.handle
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    }
+}
+
+/// The union of two increasing lists of rows, increasing.
+pub(crate) fn merge_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() || j < b.len() {
+        let next = match (a.get(i), b.get(j)) {
+            (Some(&x), Some(&y)) if x <= y => x,
+            (_, Some(&y)) => y,
+            (Some(&x), None) => x,
+            (None, None) => unreachable!("one list has more"),
+        };
+        i += usize::from(a.get(i) == Some(&next));
+        j += usize::from(b.get(j) == Some(&next));
+        out.push(next);
+    }
+    out
+}
+
 static NEXT_PLAN: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
 /// A drag in progress.
@@ -136,9 +316,10 @@ pub struct DragPlan {
     /// Every control point an event may move (sorted), and how: ΔP_c = beta_c ⊙ Δ.
     pub touched: Vec<ControlId>,
     beta: Vec<Vector3>,
-    /// The vertices those control points reach (sorted), and how they move.
-    pub rows: Vec<u32>,
-    pub moves: Vec<DragRow>,
+    /// The vertices those control points reach (sorted), and how they move (shared with the
+    /// job that makes the next plan, which settles them).
+    pub rows: Arc<Vec<u32>>,
+    pub moves: Arc<Vec<DragRow>>,
     /// Names this plan (the GPU uploads a plan's rows once).
     pub id: u64,
     /// The displacement of the last event.
@@ -162,24 +343,56 @@ impl DragPlan {
         images: &[(ChartPoint, Vector3)],
         settled: &[u32],
     ) -> Result<DragPlan, EmbeddingError> {
+        let start = Start::new(surface, point, images);
+        let soft = start.shares(brush, || mesh.brush_samples(surface))?;
+        let plan = DragPlan::with_shares(surface, start, soft, pins, mesh.plan_rows(), settled)?;
+        plan.hold(mesh.vertices_mut());
+        mesh.mark_dirty(&plan.rows);
+        Ok(plan)
+    }
+
+    /// [`DragPlan::new`] from what the live mesh lent (see [`PlanJob`]); the vertices' flags are
+    /// written into the lent vertices.
+    fn from_lent(
+        surface: &Surface,
+        lent: &mut Lent,
+        point: ChartPoint,
+        pins: &[ChartPoint],
+        brush: (f64, Falloff),
+        images: &[(ChartPoint, Vector3)],
+        settled: &[u32],
+    ) -> Result<DragPlan, EmbeddingError> {
+        let start = Start::new(surface, point, images);
+        let soft = start.shares(Some(brush), || Ok(lent.samples.view(surface)))?;
+        let rows = PlanRows {
+            stencil: &lent.stencil,
+            columns: &lent.columns,
+            positions: &lent.positions,
+            tangents: &lent.tangents,
+        };
+        let plan = DragPlan::with_shares(surface, start, soft, pins, rows, settled)?;
+        plan.hold(&mut lent.vertices);
+        Ok(plan)
+    }
+
+    /// The plan for a start and the brush's shares: the pins that interact, the minimum-norm
+    /// change per unit displacement, the rows it reaches and their gains.
+    fn with_shares(
+        surface: &Surface,
+        start: Start,
+        soft: Vec<(ControlId, Vector3)>,
+        pins: &[ChartPoint],
+        mesh: PlanRows<'_>,
+        settled: &[u32],
+    ) -> Result<DragPlan, EmbeddingError> {
         let layout = &surface.layout();
         let control = surface.control_points();
-        let start = layout.eval(control, point);
-        let (start_position, start_normal) = (start.pos, start.normal());
-        let images: Vec<(ChartPoint, Point3, Vector3)> = images
-            .iter()
-            .map(|&(p, signs)| (p, layout.eval(control, p).pos, signs))
-            .collect();
-        let soft = match brush {
-            Some((radius, falloff)) if radius > 0.0 => {
-                let centres: Vec<(Point3, Vector3)> =
-                    std::iter::once((start_position, Vector3::new(1.0, 1.0, 1.0)))
-                        .chain(images.iter().map(|&(_, at, signs)| (at, signs)))
-                        .collect();
-                grab_shares_mirrored(&mesh.brush_samples(surface)?, &centres, radius, falloff)?
-            }
-            _ => Vec::new(),
-        };
+        let Start {
+            point,
+            position: start_position,
+            normal: start_normal,
+            images,
+        } = start;
         // The pins that interact with the drag: grow the set of control points that may move.
         let mut moving = vec![false; control.len()];
         let mut row = Vec::new();
@@ -235,8 +448,8 @@ impl DragPlan {
             soft,
             touched: Vec::new(),
             beta: Vec::new(),
-            rows: Vec::new(),
-            moves: Vec::new(),
+            rows: Arc::default(),
+            moves: Arc::default(),
             id: NEXT_PLAN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             displacement: Vector3::zeros(),
             residual: 0.0,
@@ -249,9 +462,9 @@ impl DragPlan {
         plan.touched = touched.iter().map(|t| t.0).collect();
         plan.beta = touched.iter().map(|t| t.1).collect();
         // The rows reached, in increasing order.
-        plan.rows = mesh
-            .stencil()
-            .rows_of_controls(mesh.columns(), plan.touched.iter().map(|c| c.index()));
+        let rows = mesh
+            .stencil
+            .rows_of_controls(mesh.columns, plan.touched.iter().map(|c| c.index()));
         // Each reached row's gains from its own stencil row (streamed, in parallel), with β looked up
         // by control point.
         let mut beta = vec![Vector3::zeros(); control.len()];
@@ -263,7 +476,7 @@ impl DragPlan {
         // stencil rows streamed here anyway.
         let mut stale = Vec::new();
         if !settled.is_empty() {
-            stale = vec![0u64; mesh.vertex_count().div_ceil(64)];
+            stale = vec![0u64; mesh.positions.len().div_ceil(64)];
             for &r in settled {
                 stale[r as usize / 64] |= 1 << (r % 64);
             }
@@ -273,9 +486,9 @@ impl DragPlan {
                 .get(r as usize / 64)
                 .is_some_and(|w| w & (1 << (r % 64)) != 0)
         };
-        let (stencil, positions, tangents) = (mesh.stencil(), mesh.positions(), mesh.tangents());
-        plan.moves = vec![DragRow::default(); plan.rows.len()];
-        parallel_chunks(&plan.rows, &mut plan.moves, |rows, out| {
+        let (stencil, positions, tangents) = (mesh.stencil, mesh.positions, mesh.tangents);
+        let mut moves = vec![DragRow::default(); rows.len()];
+        parallel_chunks(&rows, &mut moves, |rows, out| {
             for (o, &r) in out.iter_mut().zip(rows) {
                 let stale = is_stale(r);
                 let (mut g, mut base) = ([0.0f64; 9], [Vector3::zeros(); 3]);
@@ -305,13 +518,16 @@ impl DragPlan {
                 };
             }
         });
-        // Tell the GPU copy which vertices follow the drag (flags: the row's index + 1).
-        let vertices = mesh.vertices_mut();
-        for (k, &r) in plan.rows.iter().enumerate() {
+        plan.rows = Arc::new(rows);
+        plan.moves = Arc::new(moves);
+        Ok(plan)
+    }
+
+    /// Tells the GPU copy which vertices follow the drag (flags: the row's index + 1).
+    pub(crate) fn hold(&self, vertices: &mut [ViewVertex]) {
+        for (k, &r) in self.rows.iter().enumerate() {
             vertices[r as usize].flags = k as u32 + 1;
         }
-        mesh.mark_dirty(&plan.rows);
-        Ok(plan)
     }
 
     /// The minimum-norm change for displacement `delta` of the dragged point: (control point,
@@ -371,7 +587,20 @@ impl DragPlan {
         target: Point3,
     ) -> Result<f64, EmbeddingError> {
         let delta = target - self.start_position;
-        let (moved, residual) = self.solve(&surface.layout(), delta)?;
+        let (updates, residual) = self.controls_at(&surface.layout(), delta)?;
+        surface.set_control_points_at(updates)?;
+        self.displacement = delta;
+        self.residual = residual;
+        Ok(residual)
+    }
+
+    /// The touched control points for displacement `delta` (start + change), and the residual.
+    fn controls_at(
+        &self,
+        layout: &Layout,
+        delta: Vector3,
+    ) -> Result<(Vec<(ControlId, Point3)>, f64), EmbeddingError> {
+        let (moved, residual) = self.solve(layout, delta)?;
         let mut updates: Vec<(ControlId, Point3)> = self
             .touched
             .iter()
@@ -380,21 +609,19 @@ impl DragPlan {
         for (c, d) in moved {
             updates.push((c, self.start_control[c.index()] + d));
         }
-        surface.set_control_points_at(updates.iter().copied())?;
-        self.displacement = delta;
-        self.residual = residual;
-        Ok(residual)
+        Ok((updates, residual))
     }
 
     /// Ends this plan's hold on its vertices as its last event left them: their GPU copies
     /// written (no longer following the drag) and marked for upload. Their f64 positions and
     /// tangents are not: [`LiveMesh::rows_changed`] with [`DragPlan::rows`] brings them up to date.
     pub fn settle(&self, mesh: &mut LiveMesh) {
-        let vertices = mesh.vertices_mut();
-        self.move_vertices(self.displacement, vertices);
-        for &r in &self.rows {
-            vertices[r as usize].flags = 0;
-        }
+        settle_rows(
+            &self.rows,
+            &self.moves,
+            self.displacement,
+            mesh.vertices_mut(),
+        );
         mesh.mark_dirty(&self.rows);
     }
 
@@ -402,10 +629,25 @@ impl DragPlan {
     /// the CPU: what the vertex shader does (sorted rows, so the array splits into disjoint pieces,
     /// one per thread).
     pub fn move_vertices(&self, delta: Vector3, vertices: &mut [ViewVertex]) {
+        move_rows(&self.rows, &self.moves, delta, vertices);
+    }
+}
+
+/// Writes a plan's rows at displacement `delta` into the vertices and lets go of them (flags 0).
+fn settle_rows(rows: &[u32], moves: &[DragRow], delta: Vector3, vertices: &mut [ViewVertex]) {
+    move_rows(rows, moves, delta, vertices);
+    for &r in rows {
+        vertices[r as usize].flags = 0;
+    }
+}
+
+/// What the vertex shader does with a plan's rows (`moves`, one per row) for displacement `delta`.
+fn move_rows(rows: &[u32], moves: &[DragRow], delta: Vector3, vertices: &mut [ViewVertex]) {
+    {
         let d = [delta.x as f32, delta.y as f32, delta.z as f32];
         let work = |first: usize, rows: &[u32], out: &mut [ViewVertex], offset: usize| {
             for (k, &r) in (first..).zip(rows) {
-                let DragRow { base: b, gain: g } = &self.moves[k];
+                let DragRow { base: b, gain: g } = &moves[k];
                 let p = [b[0] + g[0] * d[0], b[1] + g[1] * d[1], b[2] + g[2] * d[2]];
                 let u = [b[3] + g[3] * d[0], b[4] + g[4] * d[1], b[5] + g[5] * d[2]];
                 let v = [b[6] + g[6] * d[0], b[7] + g[7] * d[1], b[8] + g[8] * d[2]];
@@ -420,7 +662,7 @@ impl DragPlan {
                 vertex.normal = n.map(|x| x * inv);
             }
         };
-        split_by_rows(&self.rows, vertices, work);
+        split_by_rows(rows, vertices, work);
     }
 }
 

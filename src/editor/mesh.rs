@@ -8,6 +8,7 @@
 //! barycentric coordinates.
 
 use std::ops::Range;
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use charts::{ChartId, ChartPoint};
@@ -193,14 +194,30 @@ const HELD_BACK: f64 = 0.5;
 /// vertices).
 const SLACK: f64 = 0.01;
 
+/// What a grab's plan made in the background borrows from the live mesh ([`LiveMesh::lend`]).
+pub(crate) struct Lent {
+    pub stencil: Arc<Stencil>,
+    pub columns: Arc<ColumnIndex>,
+    pub positions: Arc<Vec<Point3>>,
+    pub tangents: Arc<Vec<[Vector3; 2]>>,
+    pub samples: SurfaceSamples,
+    pub vertices: Vec<ViewVertex>,
+}
+
 /// The live surface mesh (see the module documentation).
 pub struct LiveMesh {
     pub tessellation: ChartTriangles,
-    stencil: Stencil,
-    columns: ColumnIndex,
-    positions: Vec<Point3>,
-    tangents: Vec<[Vector3; 2]>,
+    /// Shared (never changed after the mesh is made) with a grab's plan made in the background.
+    stencil: Arc<Stencil>,
+    columns: Arc<ColumnIndex>,
+    /// Shared with a grab's plan made in the background, which reads them; written through
+    /// [`Arc::make_mut`], which copies only while such a plan holds them (never: a drag's events
+    /// do not write them, and its end waits for the plan).
+    positions: Arc<Vec<Point3>>,
+    tangents: Arc<Vec<[Vector3; 2]>>,
+    /// Empty while lent to a grab's plan made in the background ([`LiveMesh::lend`]).
     vertices: Vec<ViewVertex>,
+    lent: bool,
     indices: Vec<u32>,
     dirty: Dirty,
     /// A new vertex or index count: the GPU buffers must be made anew.
@@ -234,17 +251,18 @@ impl LiveMesh {
     /// Tessellates as `meshing` says, builds the stencil and evaluates every vertex.
     pub fn new(surface: &Surface, meshing: Meshing, style: Style) -> Result<LiveMesh, EditorError> {
         let tessellation = ChartTriangles::new(surface, meshing)?;
-        let stencil = Stencil::build(&surface.layout(), &tessellation.vertices);
-        let columns = stencil.column_index(surface.control_points().len());
+        let stencil = Arc::new(Stencil::build(&surface.layout(), &tessellation.vertices));
+        let columns = Arc::new(stencil.column_index(surface.control_points().len()));
         let n = tessellation.vertices.len();
         let indices = tessellation.triangles.iter().flatten().copied().collect();
         let mut mesh = LiveMesh {
             tessellation,
             stencil,
             columns,
-            positions: vec![Point3::origin(); n],
-            tangents: vec![[Vector3::zeros(); 2]; n],
+            positions: Arc::new(vec![Point3::origin(); n]),
+            tangents: Arc::new(vec![[Vector3::zeros(); 2]; n]),
             vertices: vec![ViewVertex::default(); n],
+            lent: false,
             indices,
             dirty: Dirty {
                 all: true,
@@ -325,6 +343,7 @@ impl LiveMesh {
         &self.vertices
     }
     pub(crate) fn vertices_mut(&mut self) -> &mut [ViewVertex] {
+        assert!(!self.lent, "the vertices are lent to a plan");
         &mut self.vertices
     }
     pub fn indices(&self) -> &[u32] {
@@ -350,11 +369,17 @@ impl LiveMesh {
     /// changed), or, after a new tessellation or when `new_buffers`, tells the caller to make the
     /// buffers anew from [`LiveMesh::vertices`] and [`LiveMesh::indices`]. Returns the bytes
     /// written, or `None` for "make new buffers".
+    ///
+    /// While the vertices are lent to a plan made in the background, nothing is written: what
+    /// changed waits for their return.
     pub fn upload(
         &mut self,
         new_buffers: bool,
         mut write: impl FnMut(u64, &[u8]),
     ) -> Option<usize> {
+        if self.lent {
+            return Some(0);
+        }
         let dirty = self.take_dirty();
         if self.rebuilt || new_buffers {
             self.rebuilt = false;
@@ -431,6 +456,7 @@ impl LiveMesh {
 
     /// Recolours every vertex for `style`.
     pub fn set_style(&mut self, surface: &Surface, style: Style) {
+        assert!(!self.lent, "the vertices are lent to a plan");
         self.style = style;
         self.curvature_range = None;
         let all: Vec<u32> = (0..self.positions.len() as u32).collect();
@@ -498,7 +524,7 @@ impl LiveMesh {
             &due,
             (1.0 - HELD_BACK) * seen,
             &mut self.lag,
-            &mut self.positions,
+            Arc::make_mut(&mut self.positions).as_mut_slice(),
             &mut self.vertices,
             |position, vertex, p, [u, v]| {
                 let n = u.cross(&v).normalize();
@@ -547,8 +573,12 @@ impl LiveMesh {
             blends: recolour && style == Style::Charts,
         };
         let atlas = surface.atlas();
-        let (positions, tangents, vertices) =
-            (&mut self.positions, &mut self.tangents, &mut self.vertices);
+        assert!(!self.lent, "the vertices are lent to a plan");
+        let (positions, tangents, vertices) = (
+            Arc::make_mut(&mut self.positions),
+            Arc::make_mut(&mut self.tangents),
+            &mut self.vertices,
+        );
         let mut values = Vec::new();
         let sink = &mut |s: &Sample| {
             let (p, u, v) = (s.position, s.du, s.dv);
@@ -588,6 +618,56 @@ impl LiveMesh {
         }
         self.dirty.add_sorted(rows);
         self.unfitted.add(rows, self.positions.len(), f64::INFINITY);
+    }
+
+    /// Lends what a grab's next plan is made from to a thread of its own: the stencil, the f64
+    /// positions and tangents (shared: nothing writes them during a drag), and the brush samples
+    /// and the GPU vertices (moved out: the plan brings its samples up to date and writes its
+    /// vertices' flags and the last plan's settled vertices itself). Until
+    /// [`LiveMesh::give_back`], nothing is uploaded.
+    ///
+    /// # Panics
+    /// If they are lent already.
+    pub(crate) fn lend(&mut self, surface: &Surface) -> Result<Lent, EmbeddingError> {
+        assert!(!self.lent, "the vertices are lent to a plan");
+        let samples = match self.samples.take() {
+            Some(samples) if samples.fits(surface) => samples,
+            _ => SurfaceSamples::new(surface)?,
+        };
+        self.lent = true;
+        Ok(Lent {
+            stencil: Arc::clone(&self.stencil),
+            columns: Arc::clone(&self.columns),
+            positions: Arc::clone(&self.positions),
+            tangents: Arc::clone(&self.tangents),
+            samples,
+            vertices: std::mem::take(&mut self.vertices),
+        })
+    }
+
+    /// Takes back what [`LiveMesh::lend`] lent, with the rows (increasing) whose vertices the
+    /// plan wrote, to upload.
+    pub(crate) fn give_back(&mut self, lent: Lent, written: &[u32]) {
+        assert!(self.lent, "nothing was lent");
+        self.samples = Some(lent.samples);
+        self.vertices = lent.vertices;
+        self.lent = false;
+        self.dirty.add_sorted(written);
+    }
+
+    /// What a drag's plan reads of the mesh.
+    pub(crate) fn plan_rows(&self) -> super::drag::PlanRows<'_> {
+        super::drag::PlanRows {
+            stencil: &self.stencil,
+            columns: &self.columns,
+            positions: &self.positions,
+            tangents: &self.tangents,
+        }
+    }
+
+    /// Whether a grab's plan made in the background holds the vertices.
+    pub fn is_lent(&self) -> bool {
+        self.lent
     }
 
     /// The curvature style's colour range (95th percentile of |curvature| when the style was set).

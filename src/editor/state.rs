@@ -12,7 +12,7 @@ use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surfa
 
 use super::camera::{OrbitCamera, to_point};
 pub use super::drag::{Drag, DragStats, Grab};
-use super::drag::{DragPlan, DragRow, REPLAN, Replan};
+use super::drag::{DragPlan, DragRow, PlanFrom, PlanJob, REPLAN, Replan, SERVE, merge_sorted};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
@@ -98,6 +98,11 @@ pub struct EditorState {
     /// Whose control points to show.
     pub control_chart: Option<ChartId>,
     pub last_drag: Option<DragStats>,
+    /// A grab brush makes its next plan on a thread of its own while the last one goes on
+    /// serving the events (see [`PlanJob`]): the editor's window does, so that no event waits
+    /// for a plan. Off, each plan is made when it is due, so the result depends on the events
+    /// alone, not on timing (`ntori sculpt`, tests).
+    pub plan_in_background: bool,
 }
 
 impl EditorState {
@@ -124,6 +129,7 @@ impl EditorState {
             stroke: None,
             control_chart: None,
             last_drag: None,
+            plan_in_background: false,
         })
     }
 
@@ -168,6 +174,7 @@ impl EditorState {
         &self.mesh
     }
     pub fn mesh_mut(&mut self) -> &mut LiveMesh {
+        self.finish_plan();
         &mut self.mesh
     }
     /// How the viewport's mesh is made (and an export from the editor).
@@ -222,6 +229,7 @@ impl EditorState {
     // ------------------------------------------------------------------------------- display
 
     pub fn set_style(&mut self, style: Style) {
+        self.finish_plan();
         if style != self.mesh.style() {
             self.mesh.set_style(&self.surface, style);
         }
@@ -239,6 +247,7 @@ impl EditorState {
     /// Tessellates the surface as it stands anew (the quality tessellation follows its
     /// curvature as it was when made; after edits, a new one follows the new shape).
     pub fn remesh(&mut self, meshing: Meshing) -> Result<(), EditorError> {
+        self.finish_plan();
         let mesh = LiveMesh::new(&self.surface, meshing, self.mesh.style())?;
         self.mesh = mesh;
         self.meshing = meshing;
@@ -463,6 +472,7 @@ impl EditorState {
                 images,
                 count: 0,
                 settled: Vec::new(),
+                job: None,
             }),
             _ => None,
         };
@@ -567,39 +577,44 @@ impl EditorState {
     }
 
     /// A drag event with an explicit target for the dragged point.
+    ///
+    /// A grab brush plans anew each `step` of the way along the surface (see [`Replan`]): from
+    /// the point `step` along, the last plan settles and the next is made from there. In the
+    /// background ([`EditorState::plan_in_background`]) the last plan goes on serving the events
+    /// until the next is made, or until the point has gone [`SERVE`] of the radius from its start
+    /// (then the event waits for it).
     pub fn drag_to_target(&mut self, target: Point3) -> Result<(), EditorError> {
         let Some(drag) = &mut self.drag else {
             return Ok(());
         };
         let started = Instant::now();
-        // A grab brush plans anew each `step` of the way (see `Replan`).
         while let Some(replan) = &mut drag.replan {
             let delta = target - drag.plan.start_position;
             let normal = drag.plan.start_normal;
             let along = (delta - normal * delta.dot(&normal)).norm();
+            if let Some(job) = replan.job.take() {
+                let wait = !self.plan_in_background || along > SERVE / REPLAN * replan.step;
+                if !wait && !job.is_finished() {
+                    replan.job = Some(job);
+                    break;
+                }
+                install(drag, &mut self.surface, &mut self.mesh, job)?;
+                continue;
+            }
             // (No normal where the surface is degenerate: no plan anew.)
             if along <= replan.step || !along.is_finite() {
                 break;
             }
             let via = drag.plan.start_position + delta * (replan.step / along);
-            drag.plan.drag_to(&mut self.surface, via)?;
-            // The old plan's vertices as its gains put them (the f64 copies at the release), the
-            // brush's samples where the surface now is, and the next plan from here.
-            drag.plan.settle(&mut self.mesh);
-            replan.settled = merge_sorted(&replan.settled, &drag.plan.rows);
-            self.mesh
-                .brush_controls_moved(&self.surface, &drag.plan.touched);
-            let point = drag.plan.point;
-            drag.plan = DragPlan::new(
-                &self.surface,
-                &mut self.mesh,
-                point,
-                &replan.pins,
-                Some(replan.brush),
-                &replan.images,
-                &replan.settled,
-            )?;
-            replan.count += 1;
+            let from = PlanFrom {
+                surface: &self.surface,
+                via,
+                pins: &replan.pins,
+                brush: replan.brush,
+                images: &replan.images,
+            };
+            let settled = std::mem::take(&mut replan.settled);
+            replan.job = Some(PlanJob::start(&drag.plan, from, &mut self.mesh, settled)?);
         }
         drag.plan.drag_to(&mut self.surface, target)?;
         let took = started.elapsed();
@@ -607,6 +622,23 @@ impl EditorState {
         drag.busy += took;
         drag.last = took;
         Ok(())
+    }
+
+    /// Waits for a grab's next plan if one is being made, and puts it in place where the last
+    /// event took the point: the mesh is the editor's alone again.
+    pub fn finish_plan(&mut self) {
+        let Some(drag) = &mut self.drag else {
+            return;
+        };
+        let Some(job) = drag.replan.as_mut().and_then(|r| r.job.take()) else {
+            return;
+        };
+        let target = drag.plan.start_position + drag.plan.displacement;
+        let placed = install(drag, &mut self.surface, &mut self.mesh, job)
+            .and_then(|()| Ok(drag.plan.drag_to(&mut self.surface, target).map(|_| ())?));
+        if let Err(e) = placed {
+            tracing::warn!("the grab's next plan could not be put in place: {e}");
+        }
     }
 
     /// The drag as the GPU shows it: the plan's id, the vertices it moves and how, and the
@@ -633,6 +665,7 @@ impl EditorState {
     /// joins the history.
     pub fn release(&mut self) {
         self.end_stroke();
+        self.finish_plan();
         let Some(drag) = self.drag.take() else {
             return;
         };
@@ -673,6 +706,7 @@ impl EditorState {
 
     /// Abandons the drag (or the stroke): the control points go back to where they were.
     pub fn cancel_drag(&mut self) {
+        self.finish_plan();
         if let Some(stroke) = self.stroke.take() {
             let (indices, before): (Vec<ControlId>, Vec<Point3>) = stroke.moved().unzip();
             // The starting control points were valid, so restoring them cannot fail.
@@ -788,6 +822,7 @@ impl EditorState {
         settings: SplineSettings,
         control: Vec<Point3>,
     ) -> Result<(), EditorError> {
+        self.finish_plan();
         let mut surface = Surface::new(self.surface.shared_atlas(), settings, control)?;
         // Pins are surface points, whatever the spline settings.
         surface.set_pins(self.pins().to_vec())?;
@@ -828,22 +863,37 @@ impl EditorState {
 /// How close (in pixels) a press must be to a pin to grab it.
 pub const PIN_RADIUS_PX: f64 = 7.0;
 
-/// The union of two increasing lists, increasing.
-fn merge_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() || j < b.len() {
-        let next = match (a.get(i), b.get(j)) {
-            (Some(&x), Some(&y)) if x <= y => x,
-            (_, Some(&y)) => y,
-            (Some(&x), None) => x,
-            (None, None) => unreachable!("one list has more"),
-        };
-        i += usize::from(a.get(i) == Some(&next));
-        j += usize::from(b.get(j) == Some(&next));
-        out.push(next);
-    }
-    out
+/// Puts a grab's next plan in place (made by `job` from the point `via` of the last plan's way):
+/// the mesh takes back what it lent, with the vertices the job wrote, and the control points the
+/// last plan moved beyond `via` go back there, where the new plan starts. If the plan failed, the
+/// last one goes on (its vertices follow it again) and the error is returned.
+fn install(
+    drag: &mut Drag,
+    surface: &mut Surface,
+    mesh: &mut LiveMesh,
+    job: PlanJob,
+) -> Result<(), EditorError> {
+    let done = job.join();
+    mesh.give_back(done.lent, &done.written);
+    let replan = drag.replan.as_mut().expect("a grab brush plans anew");
+    replan.settled = done.settled;
+    let plan = match done.plan {
+        Ok(plan) => plan,
+        Err(e) => {
+            drag.plan.hold(mesh.vertices_mut());
+            mesh.mark_dirty(&drag.plan.rows);
+            return Err(e.into());
+        }
+    };
+    let back = drag
+        .plan
+        .touched
+        .iter()
+        .map(|&c| (c, plan.start_control[c.index()]));
+    surface.set_control_points_at(back)?;
+    drag.plan = plan;
+    replan.count += 1;
+    Ok(())
 }
 
 /// The control points that differ from `origin`, in order.
