@@ -1865,6 +1865,69 @@ fn symmetry_mirrors_the_edit_in_one_solve() {
     assert!(right > 1e-3 * size && (left / right - 1.0).abs() < 0.05);
 }
 
+/// A grab near a mirror plane: the point and its image, close together, are neither pulled
+/// apart across the plane (which tears the surface between them) nor together (which folds it:
+/// pulled 0.5 R across from 0.06 R off the X plane, the top face turned over); across the plane
+/// the point moves by at most the motion's part scaled by its distance from its image in radii,
+/// and towards it at most half the way, and it follows the rest of the motion.
+#[test]
+fn a_grab_near_a_mirror_plane_moves_along_it_without_tearing() {
+    use embedding::brush::Symmetry;
+    let mut state = brush_state();
+    let size = state.size();
+    state.influence = 0.12;
+    let radius = state.radius();
+    state.symmetry = Symmetry {
+        x: true,
+        y: false,
+        z: false,
+    };
+    let point = top_point(&state, 0.0);
+    let at = state.surface_point(point);
+    println!("the point is {:.2e} R off the X plane", at.x.abs() / radius);
+    assert!(at.x.abs() < 0.1 * radius, "a point near the plane");
+    let original = state.control().to_vec();
+    for way in [-at.x.signum(), at.x.signum()] {
+        let towards = way * at.x < 0.0;
+        let pull = Vector3::new(way * 0.5 * radius, 0.2 * radius, 0.3 * radius);
+        state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+        state.drag_to_target(at + pull).unwrap();
+        state.release();
+        let reached = state.surface_point(point);
+        let across = (reached.x - at.x).abs();
+        let allowed = if towards {
+            0.5 * at.x.abs()
+        } else {
+            2.0 * at.x.abs() / radius * pull.x.abs()
+        };
+        println!(
+            "pulled {} the plane: moved {across:.3e} across it (allowed {allowed:.3e}), {:.3} R along it",
+            if towards { "towards" } else { "away from" },
+            (reached - at).yz().norm() / radius
+        );
+        assert!(
+            across <= allowed + 1e-9 * size,
+            "{across:e} across the plane"
+        );
+        assert!(
+            ((reached - at).yz() - pull.yz()).norm() < 1e-6 * size,
+            "the rest reaches the pointer"
+        );
+        let mesh = state.mesh();
+        let lowest = mesh
+            .positions()
+            .iter()
+            .zip(mesh.tangents())
+            .filter(|(p, _)| (**p - at).norm() < 2.0 * radius && p.z > at.z - 0.2 * radius)
+            .map(|(_, [u, v])| u.cross(v).normalize().z)
+            .fold(f64::INFINITY, f64::min);
+        println!("the normals near the point face up at least {lowest:.3}");
+        assert!(lowest > 0.0, "the top face turned over: {lowest:.3}");
+        state.undo().unwrap();
+        assert_eq!(state.control(), &original[..]);
+    }
+}
+
 /// In the window: `]` and `[` scale the brush's radius, Shift + `]` and `[` change the strength
 /// (Blender's keys); a stroke of each brush dragged across the surface is one undo step; the
 /// radius is drawn as a ring on the surface under the cursor. Screenshots of each brush's result

@@ -37,7 +37,11 @@ use super::report::{Report, emit};
 /// step; default 0.5); --radius defaults to 0.15 of the model's size.
 ///
 /// --symmetry x (y, z, or any combination: xz) acts on the mirror images across those planes
-/// through the origin too, found on the surface, in the same solve.
+/// through the origin too, found on the surface, in the same solve. A grabbed point near a plane
+/// is held to its side, so that it and its image neither tear the surface apart nor fold it:
+/// across the plane it moves by the pull times its distance from its image in radii (at most
+/// the pull), towards the plane at most half the way (or to R/2 from it); a point on the plane
+/// moves along it.
 ///
 /// --script FILE reads one stroke per line, written with the same options (--brush, --at, --to,
 /// --radius, --falloff, --strength, --symmetry, --pin); blank lines and lines starting with # are
@@ -48,7 +52,8 @@ use super::report::{Report, emit};
 ///
 /// The output is written atomically; it may not be the input, and an existing file is replaced
 /// only with --force. Where pins keep a grabbed point from reaching --to (a pin at the point
-/// itself), the closest compromise is written and the exit status is 3.
+/// itself), or symmetry does (above), the closest compromise is written and the exit status is
+/// 3.
 ///
 /// Examples:
 ///   ntori sculpt model.json -o pulled.json --at 1.5,0,0.4 --to 1.5,0,1.2 --radius 1.5

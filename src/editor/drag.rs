@@ -30,7 +30,7 @@ use std::time::Duration;
 
 use charts::ChartPoint;
 use embedding::brush::BrushSamples;
-use embedding::brush::{Falloff, grab_shares_mirrored};
+use embedding::brush::{Falloff, Symmetry, grab_shares_mirrored};
 use embedding::edit::{Constraint, solve};
 use embedding::{
     ColumnIndex, ControlId, EmbeddingError, Layout, Point3, Stencil, Surface, Vector3,
@@ -60,12 +60,37 @@ pub struct Drag {
     /// make several plans: see [`Replan`]).
     pub origin: Point3,
     pub origin_control: Vec<Point3>,
+    /// A grab with mirror symmetry: how its displacement is held near the planes.
+    pub mirror: Option<MirrorHold>,
     /// A grab brush's: how to plan anew as the point travels.
     pub replan: Option<Replan>,
     pub events: u32,
     /// Time spent in drag events (solve and vertex update), in total and the last one.
     pub busy: Duration,
     pub last: Duration,
+}
+
+/// How a grab with mirror symmetry holds its displacement near the planes, so that the point and
+/// its images neither tear the surface between them nor meet
+/// ([`embedding::brush::Symmetry::limit_grab`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MirrorHold {
+    pub symmetry: Symmetry,
+    /// The brush's radius (0: the paper's edit).
+    pub radius: f64,
+    /// Closer than this to a plane, a point is on it.
+    pub tolerance: f64,
+}
+
+impl MirrorHold {
+    /// Where the point grabbed at `origin` goes for a pointer at `target`.
+    pub fn target(&self, origin: Point3, target: Point3) -> Point3 {
+        let delta = target - origin;
+        origin
+            + self
+                .symmetry
+                .limit_grab(origin, delta, self.radius, self.tolerance)
+    }
 }
 
 /// A grab brush moves the surface around the point by Δ times a falloff of the distance, and on

@@ -12,7 +12,9 @@ use embedding::{ControlId, EmbeddingError, Layout, Point3, SplineSettings, Surfa
 
 use super::camera::{OrbitCamera, to_point};
 pub use super::drag::{Drag, DragStats, Grab};
-use super::drag::{DragPlan, DragRow, PlanFrom, PlanJob, REPLAN, Replan, SERVE, merge_sorted};
+use super::drag::{
+    DragPlan, DragRow, MirrorHold, PlanFrom, PlanJob, REPLAN, Replan, SERVE, merge_sorted,
+};
 use super::history::{Change, History};
 use super::mesh::LiveMesh;
 use super::pick::Hit;
@@ -476,8 +478,14 @@ impl EditorState {
             }),
             _ => None,
         };
+        let mirror = (grab == Grab::Surface && !self.symmetry.is_empty()).then(|| MirrorHold {
+            symmetry: self.symmetry,
+            radius: brush.map_or(0.0, |b| b.0),
+            tolerance: 1e-6 * self.size(),
+        });
         self.drag = Some(Drag {
             origin: plan.start_position,
+            mirror,
             origin_control: plan.start_control.clone(),
             plan,
             press_pixel: pixel,
@@ -576,7 +584,8 @@ impl EditorState {
         self.drag_to_target(target)
     }
 
-    /// A drag event with an explicit target for the dragged point.
+    /// A drag event with an explicit target for the dragged point (with mirror symmetry, held
+    /// near the planes: see [`MirrorHold`]).
     ///
     /// A grab brush plans anew each `step` of the way along the surface (see [`Replan`]): from
     /// the point `step` along, the last plan settles and the next is made from there. In the
@@ -588,6 +597,9 @@ impl EditorState {
             return Ok(());
         };
         let started = Instant::now();
+        let target = drag
+            .mirror
+            .map_or(target, |m| m.target(drag.origin, target));
         while let Some(replan) = &mut drag.replan {
             let delta = target - drag.plan.start_position;
             let normal = drag.plan.start_normal;

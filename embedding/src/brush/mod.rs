@@ -171,6 +171,51 @@ impl Symmetry {
     pub fn is_empty(self) -> bool {
         !(self.x || self.y || self.z)
     }
+
+    /// The part of a grab's displacement `delta` that a point at `at` follows under this
+    /// symmetry, for a brush of `radius` (0: the paper's edit, where only a point closer than
+    /// `tolerance` to a plane counts as on it).
+    ///
+    /// A grab pulls the point by Δ and each mirror image by the mirrored Δ, so along an axis a
+    /// plane flips the two move in opposite ways, and near the plane they are close:
+    /// - away from the plane, that tears the surface between them (strain 2|Δ_x| over their
+    ///   distance): the part is scaled by the point's distance from its images across that axis
+    ///   in radii, capped at 1, which keeps the strain under 2|Δ_x| / R;
+    /// - towards the plane, the two would meet and the surface between them fold: the point
+    ///   stops at half its distance from the plane, or R/2 from it if that is nearer the plane.
+    ///
+    /// A point on a plane moves along it, and the result is as symmetric as the surface (a
+    /// sculpting tool's two mirrored brushes cancel across the plane likewise).
+    pub fn limit_grab(self, at: Point3, delta: Vector3, radius: f64, tolerance: f64) -> Vector3 {
+        let mut share = Vector3::new(1.0, 1.0, 1.0);
+        let mut flipped = [false; 3];
+        for signs in self.images().into_iter().skip(1) {
+            let apart = (at.coords - at.coords.component_mul(&signs)).norm();
+            let part = if radius > 0.0 {
+                (apart / radius).min(1.0)
+            } else {
+                f64::from(u8::from(apart > tolerance))
+            };
+            for axis in 0..3 {
+                if signs[axis] < 0.0 {
+                    share[axis] *= part;
+                    flipped[axis] = true;
+                }
+            }
+        }
+        let mut limited = delta;
+        for axis in (0..3).filter(|&a| flipped[a]) {
+            let (x, d) = (at[axis], delta[axis]);
+            limited[axis] = if x * d >= 0.0 {
+                d * share[axis]
+            } else {
+                // Towards the plane: at most to the stopping distance from it.
+                let stop = 0.5 * x.abs().min(radius);
+                d.signum() * d.abs().min(x.abs() - stop)
+            };
+        }
+        limited
+    }
 }
 
 /// The tessellation a brush is fitted over: the surface's layout and control points, the vertices
@@ -850,5 +895,61 @@ impl Normal {
             self.matrix[(i, i)] += EPSILON * EPSILON;
         }
         self.matrix.llt(Side::Lower).ok()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// A grab's displacement limited by [`Symmetry::limit_grab`]: along an axis a chosen plane
+        /// flips, the part away from the plane is at most Δ's times the point's distance from its
+        /// images in radii, and the point stays on its side, at least half as far from the plane
+        /// (or R/2); a point on a plane moves along it; other axes, and points a radius or more
+        /// from every image moving away, follow Δ.
+        #[test]
+        fn a_grab_near_a_mirror_plane_neither_tears_nor_folds(
+            x in -2.0f64..2.0, y in -2.0f64..2.0, z in -2.0f64..2.0,
+            on_plane in any::<bool>(),
+            planes in 1u8..8,
+            radius in 0.05f64..3.0,
+            d in prop::array::uniform3(-3.0f64..3.0),
+        ) {
+            let symmetry = Symmetry { x: planes & 1 != 0, y: planes & 2 != 0, z: planes & 4 != 0 };
+            let at = Point3::new(if on_plane { 0.0 } else { x }, y, z);
+            let delta = Vector3::from(d);
+            let limited = symmetry.limit_grab(at, delta, radius, 1e-12);
+            let chosen = [symmetry.x, symmetry.y, symmetry.z];
+            let images = symmetry.images();
+            for axis in 0..3 {
+                if !chosen[axis] {
+                    prop_assert_eq!(limited[axis], delta[axis]);
+                    continue;
+                }
+                let (x, moved) = (at[axis], limited[axis]);
+                if x == 0.0 {
+                    prop_assert_eq!(moved, 0.0);
+                    continue;
+                }
+                if x * delta[axis] >= 0.0 {
+                    // Away: scaled by the nearest image across this axis.
+                    let nearest = images.iter().skip(1).filter(|s| s[axis] < 0.0)
+                        .map(|s| (at.coords - at.coords.component_mul(s)).norm())
+                        .fold(f64::INFINITY, f64::min);
+                    prop_assert!(moved.abs() <= delta[axis].abs() * (nearest / radius).min(1.0) + 1e-12);
+                    if images.iter().skip(1).all(|s| (at.coords - at.coords.component_mul(s)).norm() >= radius) {
+                        prop_assert_eq!(moved, delta[axis]);
+                    }
+                } else {
+                    // Towards: never past half the way to the plane (or R/2 from it).
+                    let after = x + moved;
+                    prop_assert!(after * x > 0.0, "crossed the plane");
+                    prop_assert!(after.abs() >= 0.5 * x.abs().min(radius) - 1e-12);
+                    prop_assert!(moved.abs() <= delta[axis].abs());
+                }
+            }
+        }
     }
 }
