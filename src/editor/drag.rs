@@ -70,14 +70,15 @@ pub struct Drag {
     pub last: Duration,
 }
 
-/// How a grab with mirror symmetry holds its displacement near the planes, so that the point and
-/// its images neither tear the surface between them nor meet
+/// How a grab with mirror symmetry holds its displacement near the planes, so that the point
+/// moves as the brush's field moves it there and does not meet its images
 /// ([`embedding::brush::Symmetry::limit_grab`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MirrorHold {
     pub symmetry: Symmetry,
-    /// The brush's radius (0: the paper's edit).
+    /// The brush's radius (0: the paper's edit) and falloff.
     pub radius: f64,
+    pub falloff: Falloff,
     /// Closer than this to a plane, a point is on it.
     pub tolerance: f64,
 }
@@ -85,11 +86,9 @@ pub struct MirrorHold {
 impl MirrorHold {
     /// Where the point grabbed at `origin` goes for a pointer at `target`.
     pub fn target(&self, origin: Point3, target: Point3) -> Point3 {
+        let (radius, falloff, tolerance) = (self.radius, self.falloff, self.tolerance);
         let delta = target - origin;
-        origin
-            + self
-                .symmetry
-                .limit_grab(origin, delta, self.radius, self.tolerance)
+        origin + (self.symmetry).limit_grab(origin, delta, radius, falloff, tolerance)
     }
 }
 

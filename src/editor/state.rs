@@ -481,6 +481,7 @@ impl EditorState {
         let mirror = (grab == Grab::Surface && !self.symmetry.is_empty()).then(|| MirrorHold {
             symmetry: self.symmetry,
             radius: brush.map_or(0.0, |b| b.0),
+            falloff: self.falloff,
             tolerance: 1e-6 * self.size(),
         });
         self.drag = Some(Drag {
@@ -653,6 +654,24 @@ impl EditorState {
         }
     }
 
+    /// Waits for a grab's next plan if one is being made, and leaves it: the drag ends as the
+    /// last plan shows it (what the user saw, not the next plan's take on the same target). The
+    /// vertices the job wrote join the settled ones, to be made exact.
+    fn drop_plan(&mut self) {
+        let Some(drag) = &mut self.drag else {
+            return;
+        };
+        let Some(replan) = drag.replan.as_mut() else {
+            return;
+        };
+        let Some(job) = replan.job.take() else {
+            return;
+        };
+        let done = job.join();
+        self.mesh.give_back(done.lent, &done.written);
+        replan.settled = merge_sorted(&done.settled, &done.written);
+    }
+
     /// The drag as the GPU shows it: the plan's id, the vertices it moves and how, and the
     /// displacement of the last event.
     pub fn drag_display(&self) -> Option<(u64, &[DragRow], Vector3)> {
@@ -677,7 +696,7 @@ impl EditorState {
     /// joins the history.
     pub fn release(&mut self) {
         self.end_stroke();
-        self.finish_plan();
+        self.drop_plan();
         let Some(drag) = self.drag.take() else {
             return;
         };
@@ -718,7 +737,7 @@ impl EditorState {
 
     /// Abandons the drag (or the stroke): the control points go back to where they were.
     pub fn cancel_drag(&mut self) {
-        self.finish_plan();
+        self.drop_plan();
         if let Some(stroke) = self.stroke.take() {
             let (indices, before): (Vec<ControlId>, Vec<Point3>) = stroke.moved().unzip();
             // The starting control points were valid, so restoring them cannot fail.
