@@ -77,6 +77,20 @@ impl Part {
     }
 }
 
+/// Starts a grab of `point` and returns where 0.3 R along the surface from it is, and the way.
+fn start_sideways(
+    state: &mut EditorState,
+    point: charts::ChartPoint,
+) -> (embedding::Point3, Vector3) {
+    state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
+    let plan = &state.drag().expect("a drag").plan;
+    let side = plan
+        .start_normal
+        .cross(&Vector3::new(0.6, 0.8, 0.0))
+        .normalize();
+    (plan.start_position + side * (0.3 * state.radius()), side)
+}
+
 /// One grab brush that carries the point 0.3 R along the surface with its next plan made in the
 /// background, then a little further: the time `part` took.
 fn replan_in_background(
@@ -85,11 +99,7 @@ fn replan_in_background(
     part: Part,
 ) -> std::time::Duration {
     state.plan_in_background = true;
-    state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
-    let plan = &state.drag().expect("a drag").plan;
-    let normal = plan.start_normal;
-    let side = normal.cross(&Vector3::new(0.6, 0.8, 0.0)).normalize();
-    let to = plan.start_position + side * (0.3 * state.radius());
+    let (to, side) = start_sideways(state, point);
     let started = std::time::Instant::now();
     state.drag_to_target(black_box(to)).unwrap();
     let dispatch = started.elapsed();
@@ -224,11 +234,7 @@ fn drag(c: &mut Criterion) {
             b.iter_custom(|iters| {
                 let mut total = std::time::Duration::ZERO;
                 for _ in 0..iters {
-                    state.start_drag(point, Grab::Surface, [0.0, 0.0]).unwrap();
-                    let plan = &state.drag().expect("a drag").plan;
-                    let normal = plan.start_normal;
-                    let side = normal.cross(&Vector3::new(0.6, 0.8, 0.0)).normalize();
-                    let to = plan.start_position + side * (0.3 * state.radius());
+                    let (to, _) = start_sideways(&mut state, point);
                     let started = std::time::Instant::now();
                     state.drag_to_target(black_box(to)).unwrap();
                     total += started.elapsed();

@@ -1290,6 +1290,18 @@ fn enclosed_volume(state: &EditorState) -> f64 {
         .abs()
 }
 
+/// The lowest z of the unit normals at the vertices within 2 R of `near` and above `at`'s height
+/// less 0.2 R (the top face around a pulled point): below 0, the top face turned over there.
+fn lowest_upward_normal(state: &EditorState, near: Point3, at: Point3, radius: f64) -> f64 {
+    let mesh = state.mesh();
+    mesh.positions()
+        .iter()
+        .zip(mesh.tangents())
+        .filter(|(p, _)| (**p - near).norm() < 2.0 * radius && p.z > at.z - 0.2 * radius)
+        .map(|(_, [u, v])| u.cross(v).normalize().z)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The tessellation vertex on top of the default model (largest z) nearest to x on the line y = 0.
 fn top_point(state: &EditorState, x: f64) -> ChartPoint {
     let top = state
@@ -1636,16 +1648,7 @@ fn a_long_grab_along_the_surface_does_not_fold_it() {
     state.influence = 0.12;
     let radius = state.radius();
     let undo_steps = state.history().len();
-    let facing_up = |state: &EditorState| {
-        state
-            .mesh()
-            .positions()
-            .iter()
-            .zip(state.mesh().tangents())
-            .filter(|(p, _)| (**p - at).norm() < 2.0 * radius && p.z > at.z - 0.2 * radius)
-            .map(|(_, [u, v])| u.cross(v).normalize().z)
-            .fold(f64::INFINITY, f64::min)
-    };
+    let facing_up = |state: &EditorState| lowest_upward_normal(state, at, at, radius);
     println!(
         "before: the normals near the point face up at least {:.3}",
         facing_up(&state)
@@ -1810,13 +1813,7 @@ fn a_grab_planning_in_the_background_ends_as_one_planning_when_due() {
         reached < 1e-6 * size,
         "the point reached the pointer: {reached:e} off"
     );
-    let lowest = mesh
-        .positions()
-        .iter()
-        .zip(mesh.tangents())
-        .filter(|(p, _)| (**p - end).norm() < 2.0 * radius && p.z > at.z - 0.2 * radius)
-        .map(|(_, [u, v])| u.cross(v).normalize().z)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = lowest_upward_normal(&free, end, at, radius);
     println!("planning in the background: the normals near the point face up at least {lowest:.3}");
     assert!(lowest > 0.0, "the top face turned over: {lowest:.3}");
     free.undo().unwrap();
@@ -1918,14 +1915,7 @@ fn a_grab_near_a_mirror_plane_moves_along_it_without_tearing() {
             ((reached - at).yz() - pull.yz()).norm() < 1e-6 * size,
             "the rest reaches the pointer"
         );
-        let mesh = state.mesh();
-        let lowest = mesh
-            .positions()
-            .iter()
-            .zip(mesh.tangents())
-            .filter(|(p, _)| (**p - at).norm() < 2.0 * radius && p.z > at.z - 0.2 * radius)
-            .map(|(_, [u, v])| u.cross(v).normalize().z)
-            .fold(f64::INFINITY, f64::min);
+        let lowest = lowest_upward_normal(&state, at, at, radius);
         println!("the normals near the point face up at least {lowest:.3}");
         assert!(lowest > 0.0, "the top face turned over: {lowest:.3}");
         state.undo().unwrap();

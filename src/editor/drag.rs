@@ -210,7 +210,7 @@ pub(crate) struct PlanRows<'a> {
 /// A grab brush's next plan, made on a thread of its own while the last plan goes on serving the
 /// events (a plan takes about 25 ms at 10⁵ vertices and 0.1 s at 10⁶: its rows' gains, the
 /// brush's shares), so that no drag event waits for one. The live mesh lends it what it reads and
-/// the vertices it writes ([`LiveMesh::lend`]): the thread brings the brush samples to where the
+/// the vertices it writes (`LiveMesh::lend`): the thread brings the brush samples to where the
 /// last plan moved the surface, writes the last plan's vertices as it left them, and makes the
 /// plan from there.
 #[derive(Debug)]
