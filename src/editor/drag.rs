@@ -240,19 +240,22 @@ pub(crate) struct PlanFrom<'a> {
 
 impl PlanJob {
     /// Starts making the plan that follows `last` from `from.via`; `settled` the vertices of
-    /// the plans before `last`. Fails (before starting anything) if the last plan cannot reach
-    /// `via`.
+    /// the plans before `last` (taken for the job, and left as they are if it fails to start).
+    /// Fails (before starting anything) if the last plan cannot reach `via` or the brush samples
+    /// cannot be made.
     pub(crate) fn start(
         last: &DragPlan,
         from: PlanFrom<'_>,
         mesh: &mut LiveMesh,
-        settled: Vec<u32>,
+        settled: &mut Vec<u32>,
     ) -> Result<PlanJob, EmbeddingError> {
         let mut surface = from.surface.clone();
         let delta = from.via - last.start_position;
         let (updates, _) = last.controls_at(&surface.layout(), delta)?;
         surface.set_control_points_at(updates)?;
         let mut lent = mesh.lend(&surface)?;
+        // Lent to the job only now that nothing can fail.
+        let settled = std::mem::take(settled);
         let (rows, moves, touched) = (
             Arc::clone(&last.rows),
             Arc::clone(&last.moves),

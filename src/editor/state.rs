@@ -626,8 +626,9 @@ impl EditorState {
                 brush: replan.brush,
                 images: &replan.images,
             };
-            let settled = std::mem::take(&mut replan.settled);
-            replan.job = Some(PlanJob::start(&drag.plan, from, &mut self.mesh, settled)?);
+            let settled = &mut replan.settled;
+            let job = PlanJob::start(&drag.plan, from, &mut self.mesh, settled)?;
+            replan.job = Some(job);
         }
         drag.plan.drag_to(&mut self.surface, target)?;
         let took = started.elapsed();
