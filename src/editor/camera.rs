@@ -31,6 +31,11 @@ impl Ray {
     }
 }
 
+/// A pixel's width at `depth` on the view axis, in a viewport `height` pixels high.
+fn pixel_at_centre(depth: f64, height: f64) -> f64 {
+    2.0 * depth * (FOV_DEG.to_radians() / 2.0).tan() / height.max(1.0)
+}
+
 /// An orbit camera: it looks at `target` from `distance` away, from the direction given by azimuth
 /// (about the vertical z axis) and elevation (above the horizontal plane), both in degrees.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -179,9 +184,28 @@ impl OrbitCamera {
     /// Moves the target so that what was under the cursor stays under it.
     pub fn pan(&mut self, delta: [f64; 2], height: f64) {
         let (right, up) = self.basis();
-        let world_per_pixel =
-            2.0 * self.distance * (FOV_DEG.to_radians() / 2.0).tan() / height.max(1.0);
+        let world_per_pixel = pixel_at_centre(self.distance, height);
         self.target += (-right * delta[0] + up * delta[1]) * world_per_pixel;
+    }
+
+    /// The shortest motion at `depth` (along the view direction) that can move a point by a
+    /// whole pixel anywhere in a viewport of `size` pixels: a pixel's width at the centre, over
+    /// √(1 + t²) for the tangent t of the angle between the view direction and the viewport's
+    /// corner (off the axis, motion along the ray moves the image too).
+    pub fn pixel_at(&self, depth: f64, size: [f64; 2]) -> f64 {
+        let half = (FOV_DEG.to_radians() / 2.0).tan();
+        let aspect = size[0] / size[1].max(1.0);
+        let corner = half * (1.0 + aspect * aspect).sqrt();
+        pixel_at_centre(depth.max(0.0), size[1]) / (1.0 + corner * corner).sqrt()
+    }
+
+    /// The least depth along the view direction among `points` (negative: behind the eye).
+    pub fn nearest_depth(&self, points: &[Point3]) -> f64 {
+        let (eye, forward) = (self.eye(), -self.direction());
+        points
+            .iter()
+            .map(|&p| (to_glam(p) - eye).dot(forward))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Zooms by a factor (> 1: closer), within a range about the scene's size.

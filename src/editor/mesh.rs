@@ -1,7 +1,8 @@
 //! The surface as the viewport shows it: the tessellation, its stencil, every vertex's exact position
-//! and tangents (f64; during a stroke, positions within [`UNSEEN`] of the model's size and tangents
-//! as of the stroke's start, until its end), the vertices as the GPU reads them (f32, indexed), which
-//! of them changed since the last upload, the picking hierarchy, and the surface's brush samples.
+//! and tangents (f64; during a stroke, positions within the stroke's lag budget, under half a pixel
+//! where the view allows, and tangents as of the stroke's start, until its end), the vertices as
+//! the GPU reads them (f32, indexed), which of them changed since the last upload, the picking
+//! hierarchy, and the surface's brush samples.
 //!
 //! Vertices are shared between triangles (an index buffer), so an edit rewrites each moved vertex
 //! once; the GPU pulls them by index (see `gpu.rs`), so the wireframe still gets per-corner
@@ -179,12 +180,17 @@ impl ChartTriangles {
     }
 }
 
-/// During a stroke, no vertex is further than this fraction of the model's size from where the
-/// control points put it (a tenth of a pixel where the model fills a 1000-pixel view): see
-/// [`LiveMesh::controls_moved`].
+/// During a stroke a vertex may lag the surface by this much of a pixel at the nearest depth a
+/// vertex can have (see `EditorState::lag_budget`; [`LiveMesh::controls_moved`] keeps the lag):
+/// a hair from the edge of what shows.
+pub const LAG_PIXELS: f64 = 0.4;
+
+/// The least lag a stroke is allowed, as a fraction of the model's size, where the view allows
+/// less (close up, with vertices near the eye; a tenth of a pixel where the model fills a
+/// 1000-pixel view) or there is none.
 pub const UNSEEN: f64 = 1e-4;
 
-/// The share of [`UNSEEN`] that control points' motions may add up to before the vertices hear of
+/// The share of the lag allowed that control points' motions may add up to before the vertices hear of
 /// them (the rest is the vertices' own lag): see [`LiveMesh::controls_moved`].
 const HELD_BACK: f64 = 0.5;
 
@@ -331,8 +337,8 @@ impl LiveMesh {
     pub fn columns(&self) -> &ColumnIndex {
         &self.columns
     }
-    /// Exact positions (stencil × control points) of every vertex (during a stroke: within
-    /// [`UNSEEN`] of the model's size).
+    /// Exact positions (stencil × control points) of every vertex (during a stroke: within the
+    /// stroke's lag budget, [`LiveMesh::controls_moved`]).
     pub fn positions(&self) -> &[Point3] {
         &self.positions
     }
@@ -472,14 +478,14 @@ impl LiveMesh {
 
     /// After a brush's dab moved control points (each with how far): the brush samples they reach
     /// exactly, and the vertices through the f32 tensor stencil (made at the first call; within
-    /// [`UNSEEN`] of the model's size, below), on all cores; call [`LiveMesh::controls_changed`] with every
+    /// `unseen` model units of the surface, below), on all cores; call [`LiveMesh::controls_changed`] with every
     /// control point a stroke moved when it ends, to make the vertices exact. In the shaded and
     /// wireframe styles that is all a vertex shows; in the others the colours follow too (the
     /// exact, full evaluation).
     ///
     /// Most of the control points a dab moves lie at its fringe and move very little, yet reach
     /// half a million vertices at 10⁶. So the vertices follow in two stages, each with a share of
-    /// the allowed lag, [`UNSEEN`] of the model's size:
+    /// the allowed lag, `unseen`:
     /// - a control point's motion is passed on only once it adds up (as a vector, since it was
     ///   last passed on) to half of it. A row's weights are positive and sum to 1, so the
     ///   motions held back move no vertex further than that;
@@ -488,16 +494,21 @@ impl LiveMesh {
     ///   ([`TensorStencil::follow_controls`]: bounding a motion reads a row's position factors
     ///   alone, and sums scalars).
     ///
-    /// So no vertex is ever further than [`UNSEEN`] of the size from where the control points put
-    /// it.
-    pub fn controls_moved(&mut self, surface: &Surface, moved: &[(ControlId, Vector3)]) {
+    /// So no vertex is ever further than `unseen` from where the control points put it, as long
+    /// as `unseen` does not shrink during a stroke (where it must, make the vertices exact first).
+    pub fn controls_moved(
+        &mut self,
+        surface: &Surface,
+        moved: &[(ControlId, Vector3)],
+        unseen: f64,
+    ) {
         let controls: Vec<ControlId> = moved.iter().map(|m| m.0).collect();
         self.brush_controls_moved(surface, &controls);
         if matches!(self.style, Style::Curvature(_) | Style::Charts) {
             self.controls_changed(surface, &controls);
             return;
         }
-        let seen = UNSEEN * self.size;
+        let seen = unseen;
         self.pending
             .resize(surface.control_points().len(), Vector3::zeros());
         self.lag.resize(self.positions.len(), 0.0);

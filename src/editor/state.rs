@@ -16,7 +16,7 @@ use super::drag::{
     DragPlan, DragRow, MirrorHold, PlanFrom, PlanJob, REPLAN, Replan, SERVE, merge_sorted,
 };
 use super::history::{Change, History};
-use super::mesh::LiveMesh;
+use super::mesh::{LAG_PIXELS, LiveMesh, UNSEEN};
 use super::pick::Hit;
 use super::stroke::Stroke;
 use crate::io::export::Meshing;
@@ -515,8 +515,25 @@ impl EditorState {
             strength: self.strength,
         };
         self.mesh.refresh_brush_weights(&self.surface)?;
-        self.stroke = Some(Stroke::new(brush, self.control().len()));
+        let nearest = self.nearest_vertex_depth();
+        let unseen = self.lag_budget(nearest.0);
+        self.stroke = Some(Stroke::new(brush, self.control().len(), unseen, nearest));
         self.stroke_at(point)
+    }
+
+    /// The least depth of a vertex from the eye, with the eye's place and direction.
+    fn nearest_vertex_depth(&self) -> (f64, [glam::DVec3; 2]) {
+        let view = [self.camera.eye(), self.camera.direction()];
+        (self.camera.nearest_depth(self.mesh.positions()), view)
+    }
+
+    /// How far (model units) a vertex may lag the surface during a stroke when no vertex is
+    /// nearer the eye than `nearest` (along the view direction): [`LAG_PIXELS`] of a pixel there
+    /// ([`OrbitCamera::pixel_at`]), and never less than [`UNSEEN`] of the model's size. Far
+    /// vertices lag more in model units, yet less on the screen.
+    pub fn lag_budget(&self, nearest: f64) -> f64 {
+        let pixel = self.camera.pixel_at(nearest, self.viewport);
+        (LAG_PIXELS * pixel).max(UNSEEN * self.size())
     }
 
     /// The stroke's pointer is over `point`: a dab there if it has moved far enough since the last.
@@ -532,7 +549,18 @@ impl EditorState {
                     .map(|(p, signs)| (self.surface_point(p), signs)),
             )
             .collect();
+        // The budget for the view as it is now: where it moved since the last dab, the nearest
+        // vertex anew (once per move, not per dab: it reads every vertex).
+        let view = [self.camera.eye(), self.camera.direction()];
+        if self.stroke.as_ref().is_some_and(|s| s.view != view) {
+            let (nearest, view) = self.nearest_vertex_depth();
+            let stroke = self.stroke.as_mut().expect("a stroke in progress");
+            (stroke.nearest, stroke.view, stroke.approach) = (nearest, view, 0.0);
+        }
+        let stroke = self.stroke.as_ref().expect("a stroke in progress");
+        let budget = self.lag_budget(stroke.nearest - stroke.approach);
         let stroke = self.stroke.as_mut().expect("a stroke in progress");
+        stroke.set_unseen(budget, &self.surface, &mut self.mesh);
         stroke.dab(&mut self.surface, &mut self.mesh, &centres)?;
         Ok(())
     }

@@ -14,6 +14,10 @@ use super::mesh::LiveMesh;
 /// Dabs are this far apart along a stroke, as a fraction of the radius.
 pub const SPACING: f64 = 0.25;
 
+/// A lag budget this much below the stroke's so far makes the vertices exact first (see
+/// [`Stroke::set_unseen`]); one above it but still below is left as it was.
+pub const SHRINK: f64 = 0.8;
+
 /// A stroke in progress.
 #[derive(Clone, Debug)]
 pub struct Stroke {
@@ -28,11 +32,31 @@ pub struct Stroke {
     pub last_dab: Duration,
     /// How many control points the last dab moved.
     pub last_moved: usize,
+    /// How far (model units) a vertex may lag the surface (see [`LiveMesh::controls_moved`]).
+    pub unseen: f64,
+    /// The least depth a vertex had from the eye at `view`'s place, looking its way.
+    pub nearest: f64,
+    pub view: [glam::DVec3; 2],
+    /// How far the dabs may have brought a vertex nearer since: a vertex moves by no more than
+    /// the control points under it (its weights are positive and sum to 1), so by at most the
+    /// largest motion of each dab, added up.
+    pub approach: f64,
 }
 
 impl Stroke {
-    pub fn new(brush: Brush, control_count: usize) -> Stroke {
+    /// A stroke whose vertices start with a lag budget of `unseen`, the nearest `nearest` from
+    /// the eye as `view` (its place and direction) puts it.
+    pub fn new(
+        brush: Brush,
+        control_count: usize,
+        unseen: f64,
+        (nearest, view): (f64, [glam::DVec3; 2]),
+    ) -> Stroke {
         Stroke {
+            unseen,
+            nearest,
+            view,
+            approach: 0.0,
             brush,
             before: vec![None; control_count],
             last: None,
@@ -69,13 +93,28 @@ impl Stroke {
             self.before[c.index()].get_or_insert(control[c.index()]);
         }
         surface.set_control_points_at(updates.iter().copied())?;
-        mesh.controls_moved(surface, &moved);
+        mesh.controls_moved(surface, &moved, self.unseen);
+        self.approach += moved.iter().map(|m| m.1.norm()).fold(0.0, f64::max);
         self.last = centres.first().map(|c| c.0);
         self.dabs += 1;
         self.last_moved = moved.len();
         self.last_dab = started.elapsed();
         self.busy += self.last_dab;
         Ok(moved.len())
+    }
+
+    /// From now on the vertices may lag by `budget`. Where that is below [`SHRINK`] of the
+    /// budget so far (the view came closer), the vertices the stroke moved are made exact first:
+    /// no vertex lags by more than the budget over [`SHRINK`]. A larger one takes over at once
+    /// (every lag is under the old).
+    pub fn set_unseen(&mut self, budget: f64, surface: &Surface, mesh: &mut LiveMesh) {
+        if budget < SHRINK * self.unseen {
+            let moved: Vec<ControlId> = self.moved().map(|m| m.0).collect();
+            mesh.controls_changed(surface, &moved);
+        } else if budget < self.unseen {
+            return;
+        }
+        self.unseen = budget;
     }
 
     /// The control points the stroke moved, with where they were before it.
