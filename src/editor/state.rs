@@ -18,7 +18,7 @@ use super::drag::{
 use super::history::{Change, History};
 use super::mesh::{LAG_PIXELS, LiveMesh, UNSEEN};
 use super::pick::Hit;
-use super::stroke::Stroke;
+use super::stroke::{SHRINK, Stroke};
 use crate::io::export::Meshing;
 use crate::io::model_file::ModelFileError;
 use crate::render::Style;
@@ -212,6 +212,10 @@ impl EditorState {
     }
     pub fn stroke(&self) -> Option<&Stroke> {
         self.stroke.as_ref()
+    }
+    /// The stroke in progress, to change (tests set its bounds).
+    pub fn stroke_mut(&mut self) -> Option<&mut Stroke> {
+        self.stroke.as_mut()
     }
     /// Whether a drag or a stroke is in progress.
     pub fn busy(&self) -> bool {
@@ -549,16 +553,18 @@ impl EditorState {
                     .map(|(p, signs)| (self.surface_point(p), signs)),
             )
             .collect();
-        // The budget for the view as it is now: where it moved since the last dab, the nearest
-        // vertex anew (once per move, not per dab: it reads every vertex).
+        // The budget for the view as it is now. Where the view moved since the last dab, or the
+        // bound on how near the dabs brought a vertex would shrink it (that would make the
+        // vertices exact), the nearest vertex anew: a pass over the vertices, not one per dab.
         let view = [self.camera.eye(), self.camera.direction()];
-        if self.stroke.as_ref().is_some_and(|s| s.view != view) {
+        let stroke = self.stroke.as_ref().expect("a stroke in progress");
+        let mut budget = self.lag_budget(stroke.nearest - stroke.approach);
+        if stroke.view != view || budget < SHRINK * stroke.unseen {
             let (nearest, view) = self.nearest_vertex_depth();
+            budget = self.lag_budget(nearest);
             let stroke = self.stroke.as_mut().expect("a stroke in progress");
             (stroke.nearest, stroke.view, stroke.approach) = (nearest, view, 0.0);
         }
-        let stroke = self.stroke.as_ref().expect("a stroke in progress");
-        let budget = self.lag_budget(stroke.nearest - stroke.approach);
         let stroke = self.stroke.as_mut().expect("a stroke in progress");
         stroke.set_unseen(budget, &self.surface, &mut self.mesh);
         stroke.dab(&mut self.surface, &mut self.mesh, &centres)?;
