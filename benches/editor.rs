@@ -357,8 +357,8 @@ fn stroke_steps(
         // ray meets the picking boxes grown by how far the dabs moved the vertices, or refitted
         // once that is 1% of the size.
         let name = format!("pick_after_dab_{}", kind.name());
-        let centre = [state.viewport[0] / 2.0, state.viewport[1] / 2.0];
         if view.is_empty() {
+            let centre = [state.viewport[0] / 2.0, state.viewport[1] / 2.0];
             group.bench_function(BenchmarkId::new(name, n), |b| {
                 b.iter_custom(|iters| {
                     let mut total = std::time::Duration::ZERO;

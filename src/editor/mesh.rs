@@ -508,7 +508,6 @@ impl LiveMesh {
             self.controls_changed(surface, &controls);
             return;
         }
-        let seen = unseen;
         self.pending
             .resize(surface.control_points().len(), Vector3::zeros());
         self.lag.resize(self.positions.len(), 0.0);
@@ -517,7 +516,7 @@ impl LiveMesh {
             .filter_map(|&(c, d)| {
                 let pending = &mut self.pending[c.index()];
                 *pending += d;
-                (pending.norm() >= HELD_BACK * seen).then(|| (c.0, std::mem::take(pending)))
+                (pending.norm() >= HELD_BACK * unseen).then(|| (c.0, std::mem::take(pending)))
             })
             .collect();
         if due.is_empty() {
@@ -533,7 +532,7 @@ impl LiveMesh {
         let followed = tensor.follow_controls(
             surface.control_points(),
             &due,
-            (1.0 - HELD_BACK) * seen,
+            (1.0 - HELD_BACK) * unseen,
             &mut self.lag,
             Arc::make_mut(&mut self.positions).as_mut_slice(),
             &mut self.vertices,
@@ -548,8 +547,8 @@ impl LiveMesh {
         if !followed.rows.is_empty() {
             self.dirty.add_sorted(&followed.rows);
             // How far a written vertex moved: at most its lag, with the motions held back when it
-            // was last evaluated and now (each under HELD_BACK of `seen`).
-            let moved = followed.largest_lag + 2.0 * HELD_BACK * seen;
+            // was last evaluated and now (each under HELD_BACK of `unseen`).
+            let moved = followed.largest_lag + 2.0 * HELD_BACK * unseen;
             self.unfitted
                 .add(&followed.rows, self.positions.len(), moved);
         }

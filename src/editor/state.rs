@@ -519,16 +519,8 @@ impl EditorState {
             strength: self.strength,
         };
         self.mesh.refresh_brush_weights(&self.surface)?;
-        let nearest = self.nearest_vertex_depth();
-        let unseen = self.lag_budget(nearest.0);
-        self.stroke = Some(Stroke::new(brush, self.control().len(), unseen, nearest));
+        self.stroke = Some(Stroke::new(brush, self.control().len()));
         self.stroke_at(point)
-    }
-
-    /// The least depth of a vertex from the eye, with the eye's place and direction.
-    fn nearest_vertex_depth(&self) -> (f64, [glam::DVec3; 2]) {
-        let view = [self.camera.eye(), self.camera.direction()];
-        (self.camera.nearest_depth(self.mesh.positions()), view)
     }
 
     /// How far (model units) a vertex may lag the surface during a stroke when no vertex is
@@ -553,17 +545,18 @@ impl EditorState {
                     .map(|(p, signs)| (self.surface_point(p), signs)),
             )
             .collect();
-        // The budget for the view as it is now. Where the view moved since the last dab, or the
-        // bound on how near the dabs brought a vertex would shrink it (that would make the
-        // vertices exact), the nearest vertex anew: a pass over the vertices, not one per dab.
+        // The budget for the view as it is now. At the first dab, where the view moved since
+        // the last, or where the bound on how near the dabs brought a vertex would shrink it
+        // (that would make the vertices exact), the nearest vertex anew: a pass over the
+        // vertices, not one per dab.
         let view = [self.camera.eye(), self.camera.direction()];
         let stroke = self.stroke.as_ref().expect("a stroke in progress");
         let mut budget = self.lag_budget(stroke.nearest - stroke.approach);
-        if stroke.view != view || budget < SHRINK * stroke.unseen {
-            let (nearest, view) = self.nearest_vertex_depth();
+        if stroke.view != Some(view) || budget < SHRINK * stroke.unseen {
+            let nearest = self.camera.nearest_depth(self.mesh.positions());
             budget = self.lag_budget(nearest);
             let stroke = self.stroke.as_mut().expect("a stroke in progress");
-            (stroke.nearest, stroke.view, stroke.approach) = (nearest, view, 0.0);
+            (stroke.nearest, stroke.view, stroke.approach) = (nearest, Some(view), 0.0);
         }
         let stroke = self.stroke.as_mut().expect("a stroke in progress");
         stroke.set_unseen(budget, &self.surface, &mut self.mesh);

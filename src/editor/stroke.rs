@@ -34,9 +34,10 @@ pub struct Stroke {
     pub last_moved: usize,
     /// How far (model units) a vertex may lag the surface (see [`LiveMesh::controls_moved`]).
     pub unseen: f64,
-    /// The least depth a vertex had from the eye at `view`'s place, looking its way.
+    /// The least depth a vertex had from the eye at `view`'s place, looking its way (none yet
+    /// before the first dab).
     pub nearest: f64,
-    pub view: [glam::DVec3; 2],
+    pub view: Option<[glam::DVec3; 2]>,
     /// How far the dabs may have brought a vertex nearer since: a vertex moves by no more than
     /// the control points under it (its weights are positive and sum to 1), so by at most the
     /// largest motion of each dab, added up.
@@ -44,18 +45,12 @@ pub struct Stroke {
 }
 
 impl Stroke {
-    /// A stroke whose vertices start with a lag budget of `unseen`, the nearest `nearest` from
-    /// the eye as `view` (its place and direction) puts it.
-    pub fn new(
-        brush: Brush,
-        control_count: usize,
-        unseen: f64,
-        (nearest, view): (f64, [glam::DVec3; 2]),
-    ) -> Stroke {
+    /// A stroke with no lag budget yet: the first dab sets it (`EditorState::stroke_at`).
+    pub fn new(brush: Brush, control_count: usize) -> Stroke {
         Stroke {
-            unseen,
-            nearest,
-            view,
+            unseen: 0.0,
+            nearest: 0.0,
+            view: None,
             approach: 0.0,
             brush,
             before: vec![None; control_count],
