@@ -25,6 +25,8 @@
 //!   surface, here 0.4 pixel of a 1280×800 viewport at the default view) of a brush whose disc
 //!   covers 5% of the surface's area; `stroke_step_smooth_close`: smooth zoomed in by 4, where
 //!   the budget is its least, `UNSEEN` of the size;
+//! - `mesh_open`: opening the model at that size (or changing the resolution): the tessellation,
+//!   its f64 stencil (built on all cores) and column index, every vertex, the picking boxes;
 //! - `pick_after_dab_inflate`, `_smooth`, `_flatten`: the pick under the pointer that comes
 //!   before a stroke's next dab (the picking boxes are refitted once the dabs have moved vertices
 //!   far enough out of them, otherwise grown).
@@ -409,5 +411,24 @@ fn next_dab(
     (points[usize::from(*flip)], restart)
 }
 
-criterion_group!(benches, drag);
+/// Opening the model at each size (or changing the resolution): tessellating, the f64 stencil and
+/// its column index, every vertex evaluated, and the picking boxes.
+fn open(c: &mut Criterion) {
+    let model = model();
+    let mut group = c.benchmark_group("editor");
+    group.sample_size(10);
+    for (n, t) in SIZES {
+        let meshing = ntori::io::export::Meshing::TeTr { te: t, tr: t };
+        group.bench_function(BenchmarkId::new("mesh_open", n), |b| {
+            b.iter(|| {
+                ntori::editor::mesh::LiveMesh::new(&model, meshing, Style::Shaded)
+                    .unwrap()
+                    .vertex_count()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, drag, open);
 criterion_main!(benches);

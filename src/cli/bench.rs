@@ -196,6 +196,13 @@ pub fn measure(
         "vertices",
         None,
     );
+    let secs = best_of(2, || stencil = Stencil::build_parallel(&layout, &pts));
+    add(
+        "stencil_build_full_all_cores",
+        pts.len() as f64 / secs,
+        "vertices",
+        None,
+    );
     progress("re-embedding");
     let mut out = vec![Point3::origin(); stencil.rows()];
     let bytes = Some(tensor.bytes_per_row());

@@ -211,7 +211,7 @@ pub fn refit(
     // About four samples per control point along each side of a chart.
     let t = (2 * settings.grid.max(surface.settings().grid)).clamp(16, 96) as u32;
     let tessellation = atlas.tessellate(t, t)?;
-    let stencil = embedding::Stencil::build(&surface.layout(), &tessellation.vertices);
+    let stencil = embedding::Stencil::build_parallel(&surface.layout(), &tessellation.vertices);
     let mut targets = vec![Point3::origin(); stencil.rows()];
     stencil.positions(surface.control_points(), &mut targets);
     let weights = vertex_areas(&targets, &tessellation.triangles);
@@ -222,7 +222,7 @@ pub fn refit(
         &weights,
         FitSettings::default(),
     )?;
-    let check = embedding::Stencil::build(&new, &tessellation.vertices);
+    let check = embedding::Stencil::build_parallel(&new, &tessellation.vertices);
     let mut now = vec![Point3::origin(); check.rows()];
     check.positions(&fitted, &mut now);
     let worst = now

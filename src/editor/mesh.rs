@@ -257,7 +257,10 @@ impl LiveMesh {
     /// Tessellates as `meshing` says, builds the stencil and evaluates every vertex.
     pub fn new(surface: &Surface, meshing: Meshing, style: Style) -> Result<LiveMesh, EditorError> {
         let tessellation = ChartTriangles::new(surface, meshing)?;
-        let stencil = Arc::new(Stencil::build(&surface.layout(), &tessellation.vertices));
+        let stencil = Arc::new(Stencil::build_parallel(
+            &surface.layout(),
+            &tessellation.vertices,
+        ));
         let columns = Arc::new(stencil.column_index(surface.control_points().len()));
         let n = tessellation.vertices.len();
         let indices = tessellation.triangles.iter().flatten().copied().collect();

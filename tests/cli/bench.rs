@@ -18,6 +18,7 @@ fn bench_prints_json_figures() {
             "locate_chart_point",
             "stencil_build",
             "stencil_build_full",
+            "stencil_build_full_all_cores",
             "reembed",
             "reembed_all_cores",
             "reembed_full_f64",
@@ -37,7 +38,7 @@ fn bench_prints_json_figures() {
         let rate = f["per_second"].as_f64().unwrap();
         assert!(rate.is_finite() && rate > 0.0, "{f}");
     }
-    for f in figures[4..7].iter().chain(&figures[8..12]) {
+    for f in figures[5..8].iter().chain(&figures[9..13]) {
         let fraction = f["fraction_of_copy_bandwidth"].as_f64().unwrap();
         assert!(
             fraction > 0.0 && fraction < 5.0,

@@ -56,7 +56,7 @@ impl SurfaceSamples {
         let control_count = surface.control_points().len();
         let t = resolution(surface.genus(), control_count);
         let tessellation = surface.atlas().tessellate(t, t)?;
-        let stencil = Stencil::build(&surface.layout(), &tessellation.vertices);
+        let stencil = Stencil::build_parallel(&surface.layout(), &tessellation.vertices);
         let columns = stencil.column_index(control_count);
         let n = stencil.rows();
         let mut samples = SurfaceSamples {

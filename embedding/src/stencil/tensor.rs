@@ -839,10 +839,10 @@ impl Part {
 
 /// One chart's share of a row while building: the point in that chart, its blend (value and,
 /// when tangents are wanted, first derivatives in the row's chart) and the transition's ψ'.
-struct Blend {
-    rep: ChartPoint,
-    jet: Jet,
-    psi: Complex64,
+pub(super) struct Blend {
+    pub(super) rep: ChartPoint,
+    pub(super) jet: Jet,
+    pub(super) psi: Complex64,
 }
 
 /// The raw blend value of each representation (no derivatives).
@@ -864,7 +864,7 @@ fn blend_values(layout: &Layout, reps: &[ChartPoint], out: &mut Vec<Blend>) {
 }
 
 /// The raw blend of each representation with its first derivatives in `p`'s chart, and ψ'.
-fn blend_jets(
+pub(super) fn blend_jets(
     layout: &Layout,
     p: ChartPoint,
     reps: &[(ChartPoint, charts::Lft)],
@@ -891,6 +891,12 @@ fn keep_counting_blends(blends: &mut Vec<Blend>) {
         let largest = b.jet.val.max(b.jet.du.abs()).max(b.jet.dv.abs());
         largest >= NEGLIGIBLE_BLEND * total
     });
+    normalise_blends(blends);
+}
+
+/// Divides each blend by their sum (value and first derivatives, by the quotient rule), so they
+/// sum to one; second derivatives are dropped.
+pub(super) fn normalise_blends(blends: &mut [Blend]) {
     let (kept, du, dv) = blends.iter().fold((0.0, 0.0, 0.0), |(s, u, v), b| {
         (s + b.jet.val, u + b.jet.du, v + b.jet.dv)
     });
