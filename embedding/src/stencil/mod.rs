@@ -44,95 +44,77 @@ impl Stencil {
     /// derivative ψ'. The same weights as [`Layout::weights`] (to rounding) without the second
     /// derivatives, which no stencil stores: a third of the work.
     pub fn build(layout: &Layout, points: &[ChartPoint]) -> Stencil {
-        let order = layout.settings().degree + 1;
-        let mut s = Stencil {
-            offsets: Vec::with_capacity(points.len() + 1),
-            ..Stencil::default()
-        };
-        // Rows hold two to three charts on average (2.1 at genus 2).
-        let expected = 5 * order * order * points.len() / 2;
-        s.controls.reserve(expected);
-        s.pos.reserve(expected);
-        s.du.reserve(expected);
-        s.dv.reserve(expected);
-        s.offsets.push(0);
-        let mut transitions = Vec::with_capacity(16);
-        let mut blends = Vec::with_capacity(16);
-        for &p in points {
-            layout
-                .atlas()
-                .locate_with_transitions_into(p, &mut transitions);
-            tensor::blend_jets(layout, p, &transitions, &mut blends);
-            tensor::normalise_blends(&mut blends);
-            // Charts come sorted and the layout is chart-major, so the row's controls increase.
-            for b in &blends {
-                s.push_chart(layout, b);
-            }
-            debug_assert!(
-                s.controls[*s.offsets.last().expect("starts with 0")..]
-                    .windows(2)
-                    .all(|w| w[0] < w[1]),
-                "a row's control points increase"
-            );
-            s.offsets.push(s.controls.len());
-        }
+        let mut s = Stencil::sized(layout, points, false);
+        let (offsets, mut rows) = s.rows_mut();
+        rows.fill(layout, points, offsets);
         s
     }
 
-    /// [`Stencil::build`] on all cores: tasks over ranges of points, joined in order (the same
-    /// rows, bit for bit). The joined arrays are written in parallel too, so their first touch
-    /// (page faults, which cost as much as the copy) is shared between the cores.
+    /// [`Stencil::build`] on all cores, bit for bit the same stencil: tasks over ranges of
+    /// points, each writing its rows in place.
     pub fn build_parallel(layout: &Layout, points: &[ChartPoint]) -> Stencil {
         use rayon::prelude::*;
-        const ROWS_PER_TASK: usize = 2048;
-        let parts: Vec<Stencil> = points
-            .par_chunks(ROWS_PER_TASK)
-            .map(|chunk| Stencil::build(layout, chunk))
-            .collect();
-        let mut offsets = Vec::with_capacity(points.len() + 1);
-        offsets.push(0);
-        for part in &parts {
-            let base = *offsets.last().expect("starts with 0");
-            offsets.extend(part.offsets[1..].iter().map(|&o| base + o));
+        let mut s = Stencil::sized(layout, points, true);
+        let (offsets, mut rest) = s.rows_mut();
+        let n = points.len();
+        let mut tasks = Vec::with_capacity(n.div_ceil(ROWS_PER_TASK));
+        for start in (0..n).step_by(ROWS_PER_TASK) {
+            let end = (start + ROWS_PER_TASK).min(n);
+            let tail = rest.split_off(offsets[end] - offsets[start]);
+            let rows = std::mem::replace(&mut rest, tail);
+            tasks.push((rows, &offsets[start..=end], &points[start..end]));
         }
-        let sizes: Vec<usize> = parts.iter().map(Stencil::nonzeros).collect();
+        tasks
+            .into_par_iter()
+            .for_each(|(mut rows, offsets, points)| rows.fill(layout, points, offsets));
+        s
+    }
+
+    /// A stencil for `points` with its row offsets set and its weights zero, to be filled: the
+    /// first pass only locates each point (how many charts hold it), so the weights are written
+    /// once, in place (an array grown and then joined is written twice, and at 10⁶ points its
+    /// first touch costs as much as the arithmetic).
+    fn sized(layout: &Layout, points: &[ChartPoint], parallel: bool) -> Stencil {
+        use rayon::prelude::*;
+        let order = layout.settings().degree + 1;
+        let count = |points: &[ChartPoint], out: &mut [usize]| {
+            let mut reps = Vec::with_capacity(16);
+            for (p, o) in points.iter().zip(out) {
+                layout.atlas().locate_into(*p, &mut reps);
+                *o = reps.len() * order * order;
+            }
+        };
+        let mut offsets = vec![0; points.len() + 1];
+        if parallel {
+            offsets[1..]
+                .par_chunks_mut(ROWS_PER_TASK)
+                .zip(points.par_chunks(ROWS_PER_TASK))
+                .for_each(|(out, points)| count(points, out));
+        } else {
+            count(points, &mut offsets[1..]);
+        }
+        for r in 0..points.len() {
+            offsets[r + 1] += offsets[r];
+        }
+        let total = offsets[points.len()];
         Stencil {
             offsets,
-            controls: joined(&parts, &sizes, |p| &p.controls),
-            pos: joined(&parts, &sizes, |p| &p.pos),
-            du: joined(&parts, &sizes, |p| &p.du),
-            dv: joined(&parts, &sizes, |p| &p.dv),
+            controls: vec![0; total],
+            pos: vec![0.0; total],
+            du: vec![0.0; total],
+            dv: vec![0.0; total],
         }
     }
 
-    /// One chart's (p + 1)² weights of the current row: with q the normalised blend (gradient
-    /// q_u, q_v in the row's chart) and ψ' = a + ib, the weight q·x_i·y_j has
-    ///   ∂_u = y_j (q_u x_i + q a x_i') + (q b y_j') x_i,
-    ///   ∂_v = y_j (q_v x_i − q b x_i') + (q a y_j') x_i,
-    /// the chain rule through a conformal map taking (f_x, f_y) to (a f_x + b f_y, −b f_x + a f_y).
-    fn push_chart(&mut self, layout: &Layout, b: &tensor::Blend) {
-        let order = layout.settings().degree + 1;
-        let basis = layout.basis();
-        let w = b.rep.coords;
-        let (fu, nu) = basis.eval(w.re, 1);
-        let (fv, nv) = basis.eval(w.im, 1);
-        let (q, qu, qv) = (b.jet.val, b.jet.du, b.jet.dv);
-        let (a, c) = (b.psi.re, b.psi.im);
-        let along_u: [[f64; 3]; crate::bspline::MAX_DEGREE + 1] = std::array::from_fn(|i| {
-            let (x, dx) = (nu[0][i], nu[1][i]);
-            [x, qu * x + q * a * dx, qv * x - q * c * dx]
-        });
-        for j in 0..order {
-            let (y, dy) = (nv[0][j], nv[1][j]);
-            let (qy, cu, cv) = (q * y, q * c * dy, q * a * dy);
-            let first = layout.control_index(b.rep.chart, fu, fv + j) as u32;
-            for (i, [x, gu, gv]) in along_u[..order].iter().enumerate() {
-                self.controls.push(first + i as u32);
-                self.pos.push(qy * x);
-                self.du.push(y * gu + cu * x);
-                self.dv.push(y * gv + cv * x);
-            }
-        }
+    /// The row offsets, and the weights as one writable range.
+    fn rows_mut(&mut self) -> (&[usize], RowsMut<'_>) {
+        let rows = RowsMut {
+            controls: &mut self.controls,
+            pos: &mut self.pos,
+            du: &mut self.du,
+            dv: &mut self.dv,
+        };
+        (&self.offsets, rows)
     }
 
     pub fn rows(&self) -> usize {
@@ -315,24 +297,94 @@ pub(crate) fn set_bits(bits: &[u64]) -> Vec<u32> {
     out
 }
 
-/// One array of each part (`field`), `sizes[k]` long, joined in order, copied on all cores.
-fn joined<T: Copy + Default + Send + Sync>(
-    parts: &[Stencil],
-    sizes: &[usize],
-    field: impl Fn(&Stencil) -> &Vec<T> + Sync,
-) -> Vec<T> {
-    use rayon::prelude::*;
-    let mut out = vec![T::default(); sizes.iter().sum()];
-    let mut pieces = Vec::with_capacity(parts.len());
-    let mut rest = out.as_mut_slice();
-    for &n in sizes {
-        let (piece, tail) = rest.split_at_mut(n);
-        pieces.push(piece);
-        rest = tail;
+/// Rows per task when a stencil is built on all cores.
+const ROWS_PER_TASK: usize = 2048;
+
+/// A range of a stencil's weights being written (each array the same range).
+struct RowsMut<'a> {
+    controls: &'a mut [u32],
+    pos: &'a mut [f64],
+    du: &'a mut [f64],
+    dv: &'a mut [f64],
+}
+
+impl<'a> RowsMut<'a> {
+    /// Leaves the first `n` weights here and returns the rest.
+    fn split_off(&mut self, n: usize) -> RowsMut<'a> {
+        let (c, c_rest) = std::mem::take(&mut self.controls).split_at_mut(n);
+        let (p, p_rest) = std::mem::take(&mut self.pos).split_at_mut(n);
+        let (u, u_rest) = std::mem::take(&mut self.du).split_at_mut(n);
+        let (v, v_rest) = std::mem::take(&mut self.dv).split_at_mut(n);
+        *self = RowsMut {
+            controls: c,
+            pos: p,
+            du: u,
+            dv: v,
+        };
+        RowsMut {
+            controls: c_rest,
+            pos: p_rest,
+            du: u_rest,
+            dv: v_rest,
+        }
     }
-    pieces
-        .into_par_iter()
-        .zip(parts)
-        .for_each(|(piece, part)| piece.copy_from_slice(field(part)));
-    out
+
+    /// Writes the rows of `points`; `offsets` are theirs (one more than the points: where each
+    /// row starts and the last ends), from the stencil's start.
+    fn fill(&mut self, layout: &Layout, points: &[ChartPoint], offsets: &[usize]) {
+        let mut transitions = Vec::with_capacity(16);
+        let mut blends = Vec::with_capacity(16);
+        let base = offsets[0];
+        let mut at = 0;
+        for (r, &p) in points.iter().enumerate() {
+            layout
+                .atlas()
+                .locate_with_transitions_into(p, &mut transitions);
+            tensor::blend_jets(layout, p, &transitions, &mut blends);
+            tensor::normalise_blends(&mut blends);
+            // Charts come sorted and the layout is chart-major, so the row's controls increase.
+            for b in &blends {
+                at = self.write_chart(layout, b, at);
+            }
+            assert_eq!(base + at, offsets[r + 1], "a point located twice alike");
+            debug_assert!(
+                self.controls[offsets[r] - base..at]
+                    .windows(2)
+                    .all(|w| w[0] < w[1]),
+                "a row's control points increase"
+            );
+        }
+    }
+
+    /// One chart's (p + 1)² weights of a row, from weight `at` on; returns where the next
+    /// begins. With q the normalised blend (gradient q_u, q_v in the row's chart) and ψ' = a + ib,
+    /// the weight q·x_i·y_j has
+    ///   ∂_u = y_j (q_u x_i + q a x_i') + (q b y_j') x_i,
+    ///   ∂_v = y_j (q_v x_i − q b x_i') + (q a y_j') x_i,
+    /// the chain rule through a conformal map taking (f_x, f_y) to (a f_x + b f_y, −b f_x + a f_y).
+    fn write_chart(&mut self, layout: &Layout, b: &tensor::Blend, mut at: usize) -> usize {
+        let order = layout.settings().degree + 1;
+        let basis = layout.basis();
+        let w = b.rep.coords;
+        let (fu, nu) = basis.eval(w.re, 1);
+        let (fv, nv) = basis.eval(w.im, 1);
+        let (q, qu, qv) = (b.jet.val, b.jet.du, b.jet.dv);
+        let (a, c) = (b.psi.re, b.psi.im);
+        let along_u: [[f64; 3]; crate::bspline::MAX_DEGREE + 1] = std::array::from_fn(|i| {
+            let (x, dx) = (nu[0][i], nu[1][i]);
+            [x, qu * x + q * a * dx, qv * x - q * c * dx]
+        });
+        for (j, (&y, &dy)) in nv[0][..order].iter().zip(&nv[1][..order]).enumerate() {
+            let (qy, cu, cv) = (q * y, q * c * dy, q * a * dy);
+            let first = layout.control_index(b.rep.chart, fu, fv + j) as u32;
+            for (i, [x, gu, gv]) in along_u[..order].iter().enumerate() {
+                self.controls[at] = first + i as u32;
+                self.pos[at] = qy * x;
+                self.du[at] = y * gu + cu * x;
+                self.dv[at] = y * gv + cv * x;
+                at += 1;
+            }
+        }
+        at
+    }
 }
