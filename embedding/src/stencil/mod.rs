@@ -32,7 +32,9 @@ pub struct Stencil {
 pub struct ColumnIndex {
     offsets: Vec<usize>,
     rows: Vec<u32>,
-    entries: Vec<usize>,
+    /// Where in the stencil's weight arrays each pair's weight is (u32: half the bytes of the
+    /// largest array an edit streams; 2³² weights would be a stencil of 10¹¹ bytes).
+    entries: Vec<u32>,
 }
 
 impl Stencil {
@@ -172,7 +174,7 @@ impl Stencil {
         control: usize,
     ) -> impl Iterator<Item = (u32, [f64; 3])> + 'a {
         (index.offsets[control]..index.offsets[control + 1]).map(move |k| {
-            let e = index.entries[k];
+            let e = index.entries[k] as usize;
             (index.rows[k], [self.pos[e], self.du[e], self.dv[e]])
         })
     }
@@ -234,12 +236,13 @@ impl Stencil {
         }
         let mut fill = counts.clone();
         let mut rows = vec![0u32; self.controls.len()];
-        let mut entries = vec![0usize; self.controls.len()];
+        let entry = |k: usize| u32::try_from(k).expect("fewer than 2³² stencil weights");
+        let mut entries = vec![0u32; self.controls.len()];
         for r in 0..self.rows() {
             for k in self.offsets[r]..self.offsets[r + 1] {
                 let c = self.controls[k] as usize;
                 rows[fill[c]] = r as u32;
-                entries[fill[c]] = k;
+                entries[fill[c]] = entry(k);
                 fill[c] += 1;
             }
         }
@@ -259,7 +262,7 @@ impl Stencil {
         positions: &mut [Point3],
     ) {
         for k in index.offsets[control]..index.offsets[control + 1] {
-            positions[index.rows[k] as usize] += delta * self.pos[index.entries[k]];
+            positions[index.rows[k] as usize] += delta * self.pos[index.entries[k] as usize];
         }
     }
 }
