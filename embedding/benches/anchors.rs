@@ -52,7 +52,12 @@ fn main() {
         println!("OpenSubdiv is not linked (apt-get install libosd-dev): ntori's side only");
     }
     let triad = triad_bandwidth(runs.max(3));
-    println!("triad bandwidth this run: {:.2} GB/s\n", triad / 1e9);
+    println!("triad bandwidth this run: {:.2} GB/s", triad / 1e9);
+    let (best, median) = round_trip(if full { 101 } else { 11 });
+    println!(
+        "rayon's round trip from this thread (an empty task on each core): best {best:.0} µs, \
+         median {median:.0} µs; work under twice that runs on the calling thread alone\n"
+    );
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -379,6 +384,30 @@ fn best_of(runs: usize, mut f: impl FnMut()) -> f64 {
     (0..runs.max(1))
         .map(|_| timed(&mut f).1)
         .fold(f64::INFINITY, f64::min)
+}
+
+/// Microseconds for an empty task on each of the pool's threads, called from outside the pool as
+/// the editor and the commands call it, a millisecond after the last (the workers asleep): the
+/// best and the median of `runs`. Small jobs scale less than 2× by about this much.
+fn round_trip(runs: usize) -> (f64, f64) {
+    let threads = rayon::current_num_threads();
+    let mut times: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+            1e6 * timed(|| {
+                rayon::scope(|s| {
+                    for k in 0..threads {
+                        s.spawn(move |_| {
+                            black_box(k);
+                        });
+                    }
+                })
+            })
+            .1
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    (times[0], times[times.len() / 2])
 }
 
 /// Bytes per second of a = b + s·c over three 64 MiB arrays (24 bytes per element, as STREAM

@@ -86,10 +86,12 @@ pub fn evaluate(
     let control = surface.control_points();
     let batch = CHUNK * threads();
     for (b, batch_points) in points.chunks(batch).enumerate() {
-        let chunks: Vec<&[ChartPoint]> = batch_points.chunks(CHUNK).collect();
+        // Equal chunks, one a thread: 10⁴ points as 8192 and 1808 would keep one core waiting.
+        let chunk = batch_points.len().div_ceil(threads()).clamp(1, CHUNK);
+        let chunks: Vec<&[ChartPoint]> = batch_points.chunks(chunk).collect();
         let results = in_parallel(&chunks, |k, pts| {
             let stencil = Stencil::build(&layout, pts);
-            let first = b * batch + k * CHUNK;
+            let first = b * batch + k * chunk;
             (0..pts.len())
                 .map(|r| {
                     let jet = stencil.position_and_tangents(control, r);

@@ -872,33 +872,106 @@ proptest! {
     }
 }
 
-/// Over many parallel tasks (a tessellation of 10⁴ vertices), all cores give the one-thread numbers.
+/// Over many parallel tasks, all cores give the one-thread numbers: every stencil and every way
+/// of applying one. 4·10⁴ rows are past each size from which the work is split over the cores
+/// (small jobs run on the calling thread: the pool's round trip would cost more).
 #[test]
-fn tensor_stencil_gives_the_same_numbers_on_all_cores() {
+fn stencils_give_the_same_numbers_on_all_cores() {
     let atlas = atlas(2);
     let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
     let control = noisy_controls(&layout, 11);
-    let points = atlas.tessellate(24, 24).unwrap().vertices;
-    assert!(points.len() > 10_000);
+    let points = atlas.tessellate(48, 48).unwrap().vertices;
+    assert!(points.len() > 40_000);
+    let n = points.len();
+    let one_thread = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let all_cores = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap();
+    let both = |f: &(dyn Fn() -> Vec<Point3> + Sync)| (one_thread.install(f), all_cores.install(f));
+
+    let (one, all) = both(&|| {
+        let stencil = Stencil::build_parallel(&layout, &points);
+        assert_eq!(stencil, Stencil::build(&layout, &points));
+        let mut out = vec![Point3::origin(); n];
+        stencil.positions(&control, &mut out);
+        out
+    });
+    assert_eq!(one, all, "the f64 stencil");
+
     let tensor = embedding::TensorStencil::build(&layout, &points);
-    let mut one = vec![Point3::origin(); points.len()];
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(|| tensor.positions(&control, &mut one));
-    let mut all = vec![Point3::origin(); points.len()];
-    tensor.positions_parallel(&control, &mut all);
-    assert_eq!(one, all);
-    // The stencil built on one thread is the same stencil.
-    let again = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(|| embedding::TensorStencil::build(&layout, &points));
-    let mut from_again = vec![Point3::origin(); points.len()];
-    again.positions(&control, &mut from_again);
-    assert_eq!(one, from_again);
+    let (one, all) = both(&|| {
+        let mut out = vec![Point3::origin(); n];
+        tensor.positions_parallel(&control, &mut out);
+        out
+    });
+    assert_eq!(one, all, "tensor positions");
+    let (one_built, all_built) = both(&|| {
+        let mut out = vec![Point3::origin(); n];
+        embedding::TensorStencil::build(&layout, &points).positions(&control, &mut out);
+        out
+    });
+    assert_eq!(one_built, all_built, "the tensor stencil built");
+    assert_eq!(one, one_built);
+
+    let framed = embedding::TensorStencil::build_with_tangents(&layout, &points);
+    let frames = |out: &mut Vec<Point3>, jets: &[(Point3, [Vector3; 2])]| {
+        out.extend(
+            jets.iter()
+                .flat_map(|(p, [u, v])| [*p, Point3::from(*u), Point3::from(*v)]),
+        );
+    };
+    let (one, all) = both(&|| {
+        let (mut p, mut t) = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
+        framed.positions_and_tangents_parallel(&control, &mut p, &mut t);
+        let jets: Vec<_> = p.into_iter().zip(t).collect();
+        let mut out = Vec::new();
+        frames(&mut out, &jets);
+        // Every other row alone, backwards.
+        let some: Vec<u32> = (0..n as u32).rev().step_by(2).collect();
+        let mut picked = vec![(Point3::origin(), [Vector3::zeros(); 2]); some.len()];
+        framed.rows_positions_and_tangents(&control, &some, &mut picked);
+        for (&r, jet) in some.iter().zip(&picked) {
+            assert_eq!(*jet, jets[r as usize], "row {r} alone");
+        }
+        // A third of the control points moved: every row that uses one, followed with no lag.
+        let moved: Vec<(u32, Vector3)> = (0..control.len() as u32)
+            .filter(|c| c % 3 == 0)
+            .map(|c| (c, Vector3::new(0.01, -0.02, 0.03)))
+            .collect();
+        let mut after = control.clone();
+        for &(c, d) in &moved {
+            after[c as usize] += d;
+        }
+        let (mut lag, mut p, mut t) = (vec![0f32; n], jets.clone(), vec![(); n]);
+        let followed = framed.follow_controls(
+            &after,
+            &moved,
+            0.0,
+            &mut lag,
+            &mut p,
+            &mut t,
+            |a, _, p, t| *a = (p, t),
+        );
+        assert!(
+            followed.rows.len() > n / 2,
+            "{} rows followed",
+            followed.rows.len()
+        );
+        assert!(followed.rows.windows(2).all(|w| w[0] < w[1]));
+        out.extend(
+            followed
+                .rows
+                .iter()
+                .map(|&r| Point3::new(r as f64, 0.0, 0.0)),
+        );
+        frames(&mut out, &p);
+        out
+    });
+    assert_eq!(one, all, "tangents, rows alone, rows followed");
 }
 
 /// Where the cubic kernel with AVX and FMA runs, the portable kernel gives the same positions to

@@ -56,12 +56,15 @@ impl Stencil {
     /// points, each writing its rows in place.
     pub fn build_parallel(layout: &Layout, points: &[ChartPoint]) -> Stencil {
         use rayon::prelude::*;
+        let n = points.len();
+        let Some(per_task) = rows_per_task(n, ROWS_PER_TASK, BUILD_NS) else {
+            return Stencil::build(layout, points);
+        };
         let mut s = Stencil::sized(layout, points, true);
         let (offsets, mut rest) = s.rows_mut();
-        let n = points.len();
-        let mut tasks = Vec::with_capacity(n.div_ceil(ROWS_PER_TASK));
-        for start in (0..n).step_by(ROWS_PER_TASK) {
-            let end = (start + ROWS_PER_TASK).min(n);
+        let mut tasks = Vec::with_capacity(n.div_ceil(per_task));
+        for start in (0..n).step_by(per_task) {
+            let end = (start + per_task).min(n);
             let tail = rest.split_off(offsets[end] - offsets[start]);
             let rows = std::mem::replace(&mut rest, tail);
             tasks.push((rows, &offsets[start..=end], &points[start..end]));
@@ -87,10 +90,11 @@ impl Stencil {
             }
         };
         let mut offsets = vec![0; points.len() + 1];
-        if parallel {
+        let split = rows_per_task(points.len(), ROWS_PER_TASK, LOCATE_NS).filter(|_| parallel);
+        if let Some(per_task) = split {
             offsets[1..]
-                .par_chunks_mut(ROWS_PER_TASK)
-                .zip(points.par_chunks(ROWS_PER_TASK))
+                .par_chunks_mut(per_task)
+                .zip(points.par_chunks(per_task))
                 .for_each(|(out, points)| count(points, out));
         } else {
             count(points, &mut offsets[1..]);
@@ -300,8 +304,41 @@ pub(crate) fn set_bits(bits: &[u64]) -> Vec<u32> {
     out
 }
 
-/// Rows per task when a stencil is built on all cores.
+/// The most rows per task when a stencil is built on all cores.
 const ROWS_PER_TASK: usize = 2048;
+
+/// About how long building a row takes on one core (ns), and locating its point: a cubic row
+/// in two or three charts (`ntori bench`'s `stencil_build_full`).
+const BUILD_NS: usize = 1200;
+const LOCATE_NS: usize = 150;
+
+/// Fewer rows than this are not worth a task of their own.
+const LEAST_ROWS_PER_TASK: usize = 256;
+
+/// Work (in nanoseconds) worth handing to rayon's pool from the calling thread. A call from a
+/// thread outside the pool (the editor's, a command's main thread) wakes a worker, which wakes
+/// the next, and the caller is woken at the end: three wake-ups of 10–70 µs each on this
+/// machine's virtual cores. Below about twice that round trip, two cores finish later than one.
+const LEAST_PARALLEL_NS: usize = 250_000;
+
+/// How to split `rows` rows of about `ns_per_row` nanoseconds each over the current rayon pool:
+/// `None` where the calling thread should do them alone (one thread, or too little work to pay
+/// for the pool's round trip), else the rows per task: at most `most`, and as many tasks as a
+/// multiple of the pool's threads, all of one size but the last. Fixed-size tasks leave a short
+/// last one, and a core waiting on it: 12 800 rows in tasks of 4096 are three full tasks and a
+/// short one, so 2 cores could be at most 1.56× one core; as four tasks of 3200 they can be 2×.
+pub(crate) fn rows_per_task(rows: usize, most: usize, ns_per_row: usize) -> Option<usize> {
+    let threads = rayon::current_num_threads().max(1);
+    if threads == 1 || rows.saturating_mul(ns_per_row) < LEAST_PARALLEL_NS {
+        return None;
+    }
+    let most = most.max(1);
+    let tasks = rows.div_ceil(most).div_ceil(threads) * threads;
+    Some(
+        rows.div_ceil(tasks)
+            .clamp(LEAST_ROWS_PER_TASK.min(most), most),
+    )
+}
 
 /// A range of a stencil's weights being written (each array the same range).
 struct RowsMut<'a> {
@@ -389,5 +426,43 @@ impl<'a> RowsMut<'a> {
             }
         }
         at
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rows_per_task;
+
+    /// Split work is in tasks of at most `most` rows, as many as a multiple of the threads and
+    /// all but the last of one size, which is never much longer; little work is not split.
+    #[test]
+    fn work_is_split_evenly_over_the_threads_or_not_at_all() {
+        for threads in [1, 2, 3, 16] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                for rows in [0, 1, 100, 1000, 12_800, 51_200, 100_003, 1_000_000] {
+                    for (most, ns) in [(2048, 1200), (4096, 15), (4096, 50), (32_768, 10)] {
+                        let split = rows_per_task(rows, most, ns);
+                        let Some(per_task) = split else {
+                            assert!(threads == 1 || rows * ns < 250_000, "{rows} rows not split");
+                            continue;
+                        };
+                        assert!(threads > 1 && rows * ns >= 250_000);
+                        assert!((1..=most).contains(&per_task), "{per_task} rows a task");
+                        let tasks = rows.div_ceil(per_task);
+                        let last = rows - (tasks - 1) * per_task;
+                        // Whole rounds over the threads, or tasks of at least 256 rows.
+                        assert!(tasks % threads == 0 || per_task == 256.min(most));
+                        assert!(
+                            last > per_task / 2 || tasks >= 4 * threads,
+                            "{rows}: {per_task} and {last}"
+                        );
+                    }
+                }
+            });
+        }
     }
 }

@@ -28,6 +28,7 @@ use rayon::prelude::*;
 
 use num_complex::Complex64;
 
+use super::rows_per_task;
 use crate::surface::{Jet, Layout, Point3, Vector3, derivatives};
 
 /// A chart whose normalised blend at a point is below this is left out of the point's row, and the
@@ -41,12 +42,21 @@ pub const NEGLIGIBLE_BLEND: f64 = 1e-7;
 /// left the kernel waiting on memory half the time once the stencil outgrew the caches.
 const PREFETCH_BLOCKS: usize = 16;
 
-/// Rows per parallel task: enough to amortise scheduling, few enough to balance the cores.
+/// The most rows per parallel task (fewer where that balances the cores better, see
+/// [`rows_per_task`]): enough to amortise scheduling, few enough to balance the cores.
 const ROWS_PER_TASK: usize = 4096;
 
-/// Rows per parallel task in [`TensorStencil::follow_controls`]: each task looks its range up in
+/// The most rows per parallel task in [`TensorStencil::follow_controls`]: each task looks its range up in
 /// every moved window's list of rows (a binary search), so fewer, larger tasks than elsewhere.
 const FOLLOW_ROWS_PER_TASK: usize = 32_768;
+
+/// About how long a row takes on one core (ns), for choosing whether to use more
+/// ([`rows_per_task`]): re-embedding a position, a position with tangents, building a row,
+/// following a row a moved window reaches (most are only bounded). From `ntori bench`.
+const POSITION_NS: usize = 15;
+const FRAME_NS: usize = 50;
+const BUILD_NS: usize = 500;
+const FOLLOW_NS: usize = 10;
 
 /// Positions = W · control points for a fixed set of surface points, W stored chart by chart in
 /// tensor form (see the module's comment).
@@ -161,10 +171,13 @@ impl TensorStencil {
 
     fn build_parts(layout: &Layout, points: &[ChartPoint], tangents: bool) -> TensorStencil {
         let settings = layout.settings();
-        let parts: Vec<Part> = points
-            .par_chunks(ROWS_PER_TASK)
-            .map(|chunk| Part::build(layout, chunk, tangents))
-            .collect();
+        let parts: Vec<Part> = match rows_per_task(points.len(), ROWS_PER_TASK, BUILD_NS) {
+            None => vec![Part::build(layout, points, tangents)],
+            Some(per_task) => points
+                .par_chunks(per_task)
+                .map(|chunk| Part::build(layout, chunk, tangents))
+                .collect(),
+        };
         let blocks: usize = parts.iter().map(|p| p.firsts.len()).sum();
         let mut s = TensorStencil {
             order: settings.degree + 1,
@@ -261,10 +274,14 @@ impl TensorStencil {
     /// [`TensorStencil::positions`] on all cores (the same numbers: each row is summed the same way).
     pub fn positions_parallel(&self, control: &[Point3], out: &mut [Point3]) {
         let frame = ControlFrame::new(control);
-        out[..self.rows()]
-            .par_chunks_mut(ROWS_PER_TASK)
-            .enumerate()
-            .for_each(|(k, chunk)| self.rows_into(&frame, k * ROWS_PER_TASK, chunk));
+        let out = &mut out[..self.rows()];
+        match rows_per_task(out.len(), ROWS_PER_TASK, POSITION_NS) {
+            None => self.rows_into(&frame, 0, out),
+            Some(per_task) => out
+                .par_chunks_mut(per_task)
+                .enumerate()
+                .for_each(|(k, chunk)| self.rows_into(&frame, k * per_task, chunk)),
+        }
     }
 
     /// positions = W · control, and the first derivatives S_u, S_v in each row's own chart (as
@@ -308,11 +325,15 @@ impl TensorStencil {
     ) {
         let frame = ControlFrame::new(control);
         let rows = self.rows();
-        positions[..rows]
-            .par_chunks_mut(ROWS_PER_TASK)
-            .zip(tangents[..rows].par_chunks_mut(ROWS_PER_TASK))
-            .enumerate()
-            .for_each(|(k, (p, t))| self.frames_into(&frame, k * ROWS_PER_TASK, p, t));
+        let (positions, tangents) = (&mut positions[..rows], &mut tangents[..rows]);
+        match rows_per_task(rows, ROWS_PER_TASK, FRAME_NS) {
+            None => self.frames_into(&frame, 0, positions, tangents),
+            Some(per_task) => positions
+                .par_chunks_mut(per_task)
+                .zip(tangents.par_chunks_mut(per_task))
+                .enumerate()
+                .for_each(|(k, (p, t))| self.frames_into(&frame, k * per_task, p, t)),
+        }
     }
 
     fn frames_into(
@@ -364,13 +385,18 @@ impl TensorStencil {
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
         let frame = ControlFrame::new(control);
         let frame = &frame;
-        rows.par_chunks(ROWS_PER_TASK)
-            .zip(out.par_chunks_mut(ROWS_PER_TASK))
-            .for_each(|(rows, out)| {
-                for (o, &r) in out.iter_mut().zip(rows) {
-                    *o = self.row_jet_of_order(frame, r as usize);
-                }
-            });
+        let jets = |rows: &[u32], out: &mut [(Point3, [Vector3; 2])]| {
+            for (o, &r) in out.iter_mut().zip(rows) {
+                *o = self.row_jet_of_order(frame, r as usize);
+            }
+        };
+        match rows_per_task(rows.len(), ROWS_PER_TASK, FRAME_NS) {
+            None => jets(rows, out),
+            Some(per_task) => rows
+                .par_chunks(per_task)
+                .zip(out.par_chunks_mut(per_task))
+                .for_each(|(rows, out)| jets(rows, out)),
+        }
     }
 
     /// After control points moved (`moved`: each with its displacement since the last call),
@@ -442,25 +468,29 @@ impl TensorStencil {
         };
         // Each task takes a range of rows, finds those a moved window reaches there (a bit each)
         // and follows them in order.
-        let parts: Vec<(Vec<u32>, f32)> = lag
-            .par_chunks_mut(FOLLOW_ROWS_PER_TASK)
-            .zip(first.par_chunks_mut(FOLLOW_ROWS_PER_TASK))
-            .zip(second.par_chunks_mut(FOLLOW_ROWS_PER_TASK))
-            .enumerate()
-            .map(|(t, ((lag, a), b))| {
-                let start = t * FOLLOW_ROWS_PER_TASK;
-                let reached = index.rows_between(&origins, start..start + lag.len());
-                let (mut rows, mut largest) = (Vec::new(), 0f32);
-                for k in super::set_bits(&reached) {
-                    let k = k as usize;
-                    if let Some(l) = follow(start + k, &mut lag[k], &mut a[k], &mut b[k]) {
-                        rows.push((start + k) as u32);
-                        largest = largest.max(l);
-                    }
+        let task = |start: usize, lag: &mut [f32], a: &mut [A], b: &mut [B]| {
+            let reached = index.rows_between(&origins, start..start + lag.len());
+            let (mut rows, mut largest) = (Vec::new(), 0f32);
+            for k in super::set_bits(&reached) {
+                let k = k as usize;
+                if let Some(l) = follow(start + k, &mut lag[k], &mut a[k], &mut b[k]) {
+                    rows.push((start + k) as u32);
+                    largest = largest.max(l);
                 }
-                (rows, largest)
-            })
-            .collect();
+            }
+            (rows, largest)
+        };
+        let parts: Vec<(Vec<u32>, f32)> = match rows_per_task(rows, FOLLOW_ROWS_PER_TASK, FOLLOW_NS)
+        {
+            None => vec![task(0, lag, first, second)],
+            Some(per_task) => lag
+                .par_chunks_mut(per_task)
+                .zip(first.par_chunks_mut(per_task))
+                .zip(second.par_chunks_mut(per_task))
+                .enumerate()
+                .map(|(t, ((lag, a), b))| task(t * per_task, lag, a, b))
+                .collect(),
+        };
         Followed {
             largest_lag: f64::from(parts.iter().map(|p| p.1).fold(0.0, f32::max)),
             rows: parts.into_iter().flat_map(|p| p.0).collect(),
