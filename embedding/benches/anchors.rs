@@ -191,8 +191,8 @@ struct Ntori {
     tensor_bytes: f64,
     tensor_blocks: f64,
     tensor_error: f64,
-    /// Full f64 stencil: build µs per point (one thread), positions/s, positions with S_u and S_v/s.
-    /// µs per point: one thread, all cores.
+    /// Full f64 stencil: build µs per point (one thread, all cores); positions/s and positions
+    /// with S_u and S_v/s (one thread).
     full_build: (f64, f64),
     full_positions: f64,
     full_derivatives: f64,

@@ -84,10 +84,12 @@ pub fn evaluate(
 ) {
     let layout = surface.layout();
     let control = surface.control_points();
-    let batch = CHUNK * threads();
+    // Asked once: `available_parallelism` reads the cgroup's files on Linux.
+    let threads = threads();
+    let batch = CHUNK * threads;
     for (b, batch_points) in points.chunks(batch).enumerate() {
         // Equal chunks, one a thread: 10⁴ points as 8192 and 1808 would keep one core waiting.
-        let chunk = batch_points.len().div_ceil(threads()).clamp(1, CHUNK);
+        let chunk = batch_points.len().div_ceil(threads).clamp(1, CHUNK);
         let chunks: Vec<&[ChartPoint]> = batch_points.chunks(chunk).collect();
         let results = in_parallel(&chunks, |k, pts| {
             let stencil = Stencil::build(&layout, pts);
@@ -125,8 +127,9 @@ pub fn evaluate_rows(
 ) {
     let layout = surface.layout();
     let control = surface.control_points();
-    let per_chunk = rows.len().div_ceil(threads()).clamp(1, CHUNK);
-    let batch = per_chunk * threads();
+    let threads = threads();
+    let per_chunk = rows.len().div_ceil(threads).clamp(1, CHUNK);
+    let batch = per_chunk * threads;
     for batch_rows in rows.chunks(batch) {
         let chunks: Vec<&[u32]> = batch_rows.chunks(per_chunk).collect();
         let results = in_parallel(&chunks, |_, rows| {

@@ -431,7 +431,7 @@ impl<'a> RowsMut<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::rows_per_task;
+    use super::{LEAST_PARALLEL_NS, LEAST_ROWS_PER_TASK, rows_per_task};
 
     /// Split work is in tasks of at most `most` rows, as many as a multiple of the threads and
     /// all but the last of one size, which is never much longer; little work is not split.
@@ -447,15 +447,18 @@ mod tests {
                     for (most, ns) in [(2048, 1200), (4096, 15), (4096, 50), (32_768, 10)] {
                         let split = rows_per_task(rows, most, ns);
                         let Some(per_task) = split else {
-                            assert!(threads == 1 || rows * ns < 250_000, "{rows} rows not split");
+                            assert!(
+                                threads == 1 || rows * ns < LEAST_PARALLEL_NS,
+                                "{rows} rows not split"
+                            );
                             continue;
                         };
-                        assert!(threads > 1 && rows * ns >= 250_000);
+                        assert!(threads > 1 && rows * ns >= LEAST_PARALLEL_NS);
                         assert!((1..=most).contains(&per_task), "{per_task} rows a task");
                         let tasks = rows.div_ceil(per_task);
                         let last = rows - (tasks - 1) * per_task;
-                        // Whole rounds over the threads, or tasks of at least 256 rows.
-                        assert!(tasks % threads == 0 || per_task == 256.min(most));
+                        // Whole rounds over the threads, or tasks of the least size.
+                        assert!(tasks % threads == 0 || per_task == LEAST_ROWS_PER_TASK.min(most));
                         assert!(
                             last > per_task / 2 || tasks >= 4 * threads,
                             "{rows}: {per_task} and {last}"
