@@ -14,7 +14,7 @@ fn main() {
     let layout = Layout::new(&atlas, model.settings).expect("a layout");
     let control = model.points();
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(model.genus));
-    for cells in [2, 4, 8, 16, 32] {
+    for cells in [2, 3, 4, 6, 8] {
         let sums = surface_integrals(&layout, &control, cells);
         println!(
             "{cells:3} cells per knot: ∫K dA {:.6} (expected {expected:.6}), ∫|K| dA {:.3}, area {:.4}",

@@ -5,7 +5,7 @@
 use std::time::Instant;
 
 use embedding::SplineSettings;
-use embedding::fit::{FitSettings, initial_model};
+use embedding::fit::{FitSettings, default_grid, default_smoothness, initial_model};
 use embedding::quality::{
     max_principal_curvature, normal_deviation_from, patch_disagreement, sample_points,
 };
@@ -25,22 +25,22 @@ fn main() {
     );
     for genus in genera {
         let start = Instant::now();
-        // NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override the fit's defaults, for tuning.
+        // NTORI_GRID, NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override `ntori new`'s defaults, for
+        // tuning.
         let defaults = FitSettings::default();
         let setting = |name: &str, default: f64| {
             std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
         };
+        let spline = SplineSettings {
+            grid: setting("NTORI_GRID", default_grid(genus) as f64) as usize,
+            ..SplineSettings::default()
+        };
         let settings = FitSettings {
             patch_weight: setting("NTORI_PATCH_WEIGHT", defaults.patch_weight),
-            smoothness: setting("NTORI_SMOOTHNESS", defaults.smoothness),
+            smoothness: setting("NTORI_SMOOTHNESS", default_smoothness(spline.grid)),
             stretch_rounds: setting("NTORI_STRETCH_ROUNDS", defaults.stretch_rounds as f64)
                 as usize,
             ..defaults
-        };
-        // NTORI_GRID overrides the spline grid.
-        let spline = SplineSettings {
-            grid: setting("NTORI_GRID", SplineSettings::default().grid as f64) as usize,
-            ..SplineSettings::default()
         };
         let resolution = setting("NTORI_RESOLUTION", 32.0) as usize;
         let fit = initial_model(genus, resolution, spline, settings).expect("the fit");
@@ -70,21 +70,43 @@ fn main() {
 
 /// On the plate's flat faces (input vertices at height ±T, away from the rims' bands) the intended
 /// normal is ±z and the mean curvature 0: the 90th percentile of the surface normal's angle from ±z,
-/// and of |H|·T (median, 90%), over those vertices. `None` for the sphere and the torus.
+/// and of |H|·T (median, 90%), over those vertices; with NTORI_CENTROIDS set, over the centres
+/// of the flat faces' triangles instead, between the points the fit sees. `None` for the sphere and
+/// the torus.
 fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)> {
     const THICKNESS: f64 = 0.35;
     if fit.surface.genus() < 2 {
         return None;
     }
-    let flat: Vec<usize> = (0..fit.mesh.positions.len())
-        .filter(|&i| (fit.mesh.positions[i].z.abs() - THICKNESS).abs() < 1e-12)
-        .collect();
-    let points: Vec<_> = flat
-        .iter()
-        .map(|&i| fit.parameterization.points[i])
-        .collect();
-    let mut angles = vec![180.0; flat.len()];
-    let mut curvatures = vec![f64::INFINITY; flat.len()];
+    let is_flat = |i: usize| (fit.mesh.positions[i].z.abs() - THICKNESS).abs() < 1e-12;
+    let points: Vec<_> = if std::env::var("NTORI_CENTROIDS").is_ok() {
+        let disk = fit.parameterization.disk.as_ref()?;
+        disk.triangles
+            .iter()
+            .filter(|t| {
+                t.iter()
+                    .all(|&c| is_flat(disk.original[c as usize] as usize))
+            })
+            .map(|t| {
+                let z = t
+                    .iter()
+                    .map(|&c| fit.parameterization.copies[c as usize])
+                    .sum::<num_complex::Complex64>()
+                    / 3.0;
+                fit.surface
+                    .atlas()
+                    .locate_model(charts::ModelPoint(z))
+                    .representations()[0]
+            })
+            .collect()
+    } else {
+        (0..fit.mesh.positions.len())
+            .filter(|&i| is_flat(i))
+            .map(|i| fit.parameterization.points[i])
+            .collect()
+    };
+    let mut angles = vec![180.0; points.len()];
+    let mut curvatures = vec![f64::INFINITY; points.len()];
     embedding::evaluate::evaluate(
         &fit.surface,
         &points,
@@ -110,6 +132,6 @@ fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)
         quantile(&mut angles, 0.9),
         quantile(&mut curvatures, 0.5),
         quantile(&mut curvatures, 0.9),
-        flat.len(),
+        points.len(),
     ))
 }

@@ -302,16 +302,57 @@ impl std::fmt::Display for FitStage {
 pub const DEFAULT_RESOLUTION: usize = 32;
 
 /// The control grid `ntori new` uses for `genus` where none is chosen: the default 32
-/// ([`SplineSettings::default`]), and 40 from genus 21 on. Measured (release, default
-/// resolution): genus 16 and 20 pass every check at 32 (Gauss–Bonnet 9.4e-6 and 6.8e-4); genus 24
-/// at 32 misses Gauss–Bonnet by 7% and its t = 64 tessellation crosses itself in 223 pairs (∫K dA
-/// does not settle with the quadrature: K spikes between samples), and at 40 passes every check
-/// (Gauss–Bonnet 4.7e-4, no crossings; 86 s, 1.3 GB). Genus 32 fails at 32 and at 48 alike.
+/// ([`SplineSettings::default`]) for the sphere, the torus and genus 2, 48 from genus 3 on (with
+/// [`default_smoothness`]'s stronger weight there). The plates' flat faces ripple where a chart's
+/// grid is too coarse for the map, which the coarse rims make anisotropic (σ₁/σ₂ 2.5–2.7 on
+/// average), and the inside chart carries more of the plate as the genus grows. Measured (release,
+/// `ntori new` and the shape_report example; patch disagreement, largest |κ| against the input's,
+/// normals from the intended shape at the 90th percentile; issue 12's targets 0.2%, 1.5×, 1°):
+///
+/// | genus | grid 32, λ = 1e-4 | grid 48, λ = 2e-3 |
+/// |---|---|---|
+/// | 2 | 0.150%, 1.17×, 0.72° | 0.044%, 1.21×, 0.36° |
+/// | 3 | 0.188%, 1.57×, 1.00° | 0.090%, 1.42×, 0.51° |
+/// | 5 | 0.276%, 1.64×, 1.36° | 0.131%, 1.44×, 0.58° |
+/// | 10 | 0.201%, 2.13×, 1.39° | 0.084%, 1.30×, 0.73° |
+///
+/// Genus 2 keeps 32: it meets those targets there, and a finer grid costs the editor's brushes
+/// (2.25 times the control points under a brush). Before this, 40 from genus 21 on: at 32 genus 24
+/// missed Gauss–Bonnet by 7% and crossed itself (K spiked between samples); genus 32 fails at 32
+/// and at 48 alike.
 pub fn default_grid(genus: u32) -> usize {
-    if genus <= 20 {
+    if genus <= 2 {
         SplineSettings::default().grid
     } else {
-        40
+        FINE_GRID
+    }
+}
+
+/// The grid [`default_grid`] gives from genus 3 on.
+pub const FINE_GRID: usize = 48;
+
+/// The smoothness weight λ for a control grid where none is chosen: [`FitSettings::default`]'s
+/// 1e-4 up to 32 per side, 2e-3 above. The second differences of a given surface's control grid
+/// shrink as the grid's spacing squared, so the same weight smooths a finer grid less (by
+/// (32/48)⁴ ≈ 0.2 at 48), and the finer grid has more freedom between the input's vertices: at 48
+/// with 1e-4 the genus-3 plate's largest |κ| was 2.70× the input's, with 2e-3 1.42×; 5e-3 changed
+/// no measure by more than 0.1 (shape_report, genus 2, 3, 5, 10; at 40, 2e-3 gave 1.18×, 1.50×,
+/// 1.37×, 1.34×).
+pub fn default_smoothness(grid: usize) -> f64 {
+    if grid <= SplineSettings::default().grid {
+        FitSettings::default().smoothness
+    } else {
+        2e-3
+    }
+}
+
+impl FitSettings {
+    /// The defaults, with [`default_smoothness`] for `grid`.
+    pub fn for_grid(grid: usize) -> FitSettings {
+        FitSettings {
+            smoothness: default_smoothness(grid),
+            ..FitSettings::default()
+        }
     }
 }
 

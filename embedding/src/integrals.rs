@@ -48,16 +48,20 @@ const NODES: [(f64, f64); 4] = [
     (0.861_136_311_594_052_6, 0.347_854_845_137_453_8),
 ];
 
-/// Cells per knot interval for [`surface_integrals`] that keep the cells about as fine in the chart
-/// as 8 per interval of a 16-point cubic grid (116 across a chart rounds to 8 there), but at least
-/// 2 per interval: the blends and the chart maps, not only the spline's knots, set how fine the
-/// rule must be, so a finer grid needs no more cells across a chart. `ntori new`'s Gauss–Bonnet
-/// check uses it. At grid 32 it gives 4 (116 cells across, 5 times fewer points than 8); measured
-/// on the default genus-2 and genus-8 plates there, ∫K dA is within 3e-6 relative of 2π(2 − 2n)
-/// at 4 cells per knot, as at 8 (`embedding/examples/gauss_bonnet.rs`).
+/// Cells per knot interval for [`surface_integrals`]: the fewest that put at least 116 cells
+/// across a chart (8 per interval of a 16-point cubic grid gave 104), and at least 2 per interval:
+/// the blends and the chart maps, not only the spline's knots, set how fine the rule must be, so a
+/// finer grid needs no more cells across a chart. `ntori new`'s Gauss–Bonnet check uses it. At grid
+/// 32 it gives 4 (116 cells across); measured on the default genus-2 and genus-8 plates there, ∫K dA
+/// is within 3e-6 relative of 2π(2 − 2n) at 4 cells per knot, as at 8. At grid 48 it gives 3 (135
+/// across): the genus-10 and genus-16 plates read 5.8e-6 and 9.4e-6 there, 1e-8 and 5.4e-6 at 4,
+/// and at 2 (90 across, what rounding down gave) 2.1e-5 and 6.9e-5, which failed issue 12's 1e-5
+/// for a quadrature too coarse, not the surface (`embedding/examples/gauss_bonnet.rs`).
 pub fn cells_per_knot(settings: crate::SplineSettings) -> usize {
     const ACROSS: usize = 116;
-    (ACROSS / settings.grid.saturating_sub(settings.degree).max(1)).max(2)
+    ACROSS
+        .div_ceil(settings.grid.saturating_sub(settings.degree).max(1))
+        .max(2)
 }
 
 /// The surface's integrals with `cells_per_knot` cells (of 4 × 4 Gauss points) per knot interval of
@@ -139,14 +143,17 @@ mod tests {
                 ..Default::default()
             })
         };
-        // The density the check used at the old default grid is unchanged there.
-        assert_eq!(at(16), 8);
+        // The density the check used at the default grid is unchanged there.
         assert_eq!(at(32), 4);
+        assert_eq!(at(16), 9);
+        assert_eq!(at(48), 3);
         for grid in 4..200 {
-            let cells = at(grid) * (grid - 3);
-            assert!(at(grid) >= 2, "grid {grid}");
+            let (cells, knots) = (at(grid), grid - 3);
+            assert!(cells >= 2, "grid {grid}");
+            assert!(cells * knots >= 116, "grid {grid}: {cells} × {knots}");
+            // The fewest that do.
             assert!(
-                cells >= 2 * (grid - 3) && (cells >= 58 || at(grid) == 2),
+                cells == 2 || (cells - 1) * knots < 116,
                 "grid {grid}: {cells}"
             );
         }

@@ -95,8 +95,9 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 /// The spline and the fit's weight, as `new` and `fit` take them.
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct FitArgs {
-    /// Control points per side of each chart's grid [default: 32 for new (40 from genus 21) and fit --cage, 20 for fit: a user's
-    /// mesh is often coarser than the plates, and a grid finer than the data overfits it]
+    /// Control points per side of each chart's grid [default: for new 32 up to genus 2 and 48 from
+    /// genus 3 (a coarser grid ripples there); 32 for fit --cage; 20 for fit: a user's mesh is
+    /// often coarser than the plates, and a grid finer than the data overfits it]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=64))]
     grid: Option<u64>,
     /// Spline degree.
@@ -107,10 +108,11 @@ struct FitArgs {
     #[arg(long, default_value_t = SplineSettings::default().continuity as u64, value_name = "K",
           value_parser = clap::value_parser!(u64).range(1..=4))]
     continuity: u64,
-    /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term).
-    #[arg(long, default_value_t = FitSettings::default().smoothness, value_name = "λ",
-          value_parser = parse_smoothness)]
-    smoothness: f64,
+    /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term)
+    /// [default: 1e-4 for grids up to 32, 2e-3 for finer ones, whose second differences are
+    /// smaller for the same shape]
+    #[arg(long, value_name = "λ", value_parser = parse_smoothness)]
+    smoothness: Option<f64>,
 }
 
 impl FitArgs {
@@ -122,7 +124,9 @@ impl FitArgs {
             grid: self.grid.map_or(default_grid, |g| g as usize),
         };
         let fit = FitSettings {
-            smoothness: self.smoothness,
+            smoothness: self
+                .smoothness
+                .unwrap_or_else(|| embedding::fit::default_smoothness(spline.grid)),
             ..FitSettings::default()
         };
         (spline, fit)

@@ -105,8 +105,13 @@ impl Jobs {
             let fail = |source| JobError::NewModel { genus, source };
             // The input mesh's resolution as `ntori new` chooses it.
             let resolution = default_resolution(genus).map_err(fail)?;
-            let fit =
-                initial_model(genus, resolution, settings, FitSettings::default()).map_err(fail)?;
+            let fit = initial_model(
+                genus,
+                resolution,
+                settings,
+                FitSettings::for_grid(settings.grid),
+            )
+            .map_err(fail)?;
             Ok(JobOutput::NewModel {
                 genus,
                 surface: fit.surface,

@@ -409,20 +409,30 @@ fn a_grid_far_finer_than_the_data_is_still_solved() {
     );
 }
 
-/// The grid grows where genus 24 needs it and nowhere below (see `default_grid`'s measurements).
+/// The grid is finer from genus 3 on, where 32 ripples (see `default_grid`'s measurements), and a
+/// finer grid gets a stronger smoothness weight unless one is chosen.
 #[test]
-fn the_default_grid_is_32_up_to_genus_20_and_40_above() {
-    use embedding::fit::default_grid;
-    for genus in 0..=20 {
+fn the_default_grid_is_32_up_to_genus_2_and_finer_above_with_more_smoothing() {
+    use embedding::fit::{FINE_GRID, default_grid, default_smoothness};
+    for genus in 0..=2 {
         assert_eq!(
             default_grid(genus),
             SplineSettings::default().grid,
             "genus {genus}"
         );
     }
-    for genus in [21, 24, 32, 64] {
-        assert_eq!(default_grid(genus), 40, "genus {genus}");
+    for genus in [3, 5, 10, 16, 21, 24, 32, 64] {
+        assert_eq!(default_grid(genus), FINE_GRID, "genus {genus}");
     }
+    assert!(FINE_GRID > SplineSettings::default().grid);
+    let base = FitSettings::default().smoothness;
+    assert_eq!(default_smoothness(SplineSettings::default().grid), base);
+    assert_eq!(default_smoothness(20), base);
+    assert!(default_smoothness(FINE_GRID) > 4.0 * base);
+    assert_eq!(
+        FitSettings::for_grid(FINE_GRID).smoothness,
+        default_smoothness(FINE_GRID)
+    );
 }
 
 /// Without a chosen resolution, high genus gets nearly the finest mesh within the default budget,
