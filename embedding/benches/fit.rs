@@ -1,7 +1,7 @@
 //! The fits, end to end, and the loops of a user's mesh:
 //!
 //! - `initial_fit`: `ntori new`'s pipeline (mesh, cut, Floater, relaxation, least squares) for
-//!   genus 2, 5 and 10 at the default resolution and spline settings. The map dominates: its
+//!   genus 2, 5 and 10 at the default resolution, grid and smoothness. The map dominates: its
 //!   sweeps and Newton steps are reported by `ntori new`.
 //! - `mesh_fit`: `ntori fit`'s pipeline (greedy loops from several base vertices, the canonical
 //!   words, the map, least squares) on a genus-4 plate mesh of about 10 000 vertices (issue 14's
@@ -12,7 +12,7 @@
 //! In test mode (`cargo test --benches`) each runs once, on meshes a quarter as fine.
 
 use criterion::{BenchmarkId, Criterion};
-use embedding::fit::{FitSettings, initial_model};
+use embedding::fit::{FitSettings, default_grid, initial_model};
 use embedding::holed::HoledMesh;
 use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
 use embedding::{Point3, SplineSettings};
@@ -33,9 +33,13 @@ fn initial_fit(c: &mut Criterion) {
     group.sample_size(10);
     for genus in [2u32, 5, 10] {
         group.bench_with_input(BenchmarkId::from_parameter(genus), &genus, |b, &g| {
-            b.iter(|| {
-                initial_model(g, 32, SplineSettings::default(), FitSettings::default()).unwrap()
-            })
+            // `ntori new`'s grid and smoothness for the genus.
+            let spline = SplineSettings {
+                grid: default_grid(g),
+                ..SplineSettings::default()
+            };
+            let settings = FitSettings::for_grid(spline.grid);
+            b.iter(|| initial_model(g, 32, spline, settings).unwrap())
         });
     }
     group.finish();
