@@ -6,7 +6,7 @@
 
 use charts::{ChartPoint, ModelPoint};
 use embedding::edit::{Constraint, solve};
-use embedding::fit::{FitSettings, InitialFit, initial_model};
+use embedding::fit::{FitSettings, InitialFit, default_grid, initial_model};
 use embedding::{Point3, SplineSettings, Surface, Vector3, bounding_box};
 
 use super::geometry::side_points;
@@ -40,15 +40,12 @@ impl Studio {
         if let Some(k) = self.fits.iter().position(|(g, _)| *g == genus) {
             return Ok(&self.fits[k].1);
         }
-        let fit = initial_model(
-            genus,
-            RESOLUTION,
-            SplineSettings::default(),
-            FitSettings::default(),
-        )
-        .map_err(|source| FiguresError::Embedding {
-            figure: figure.to_owned(),
-            source,
+        let (spline, settings) = fit_settings(genus);
+        let fit = initial_model(genus, RESOLUTION, spline, settings).map_err(|source| {
+            FiguresError::Embedding {
+                figure: figure.to_owned(),
+                source,
+            }
         })?;
         self.fits.push((genus, fit));
         Ok(&self.fits.last().expect("just pushed").1)
@@ -105,13 +102,20 @@ fn describe(o: &RenderOptions) -> String {
     )
 }
 
+/// `ntori new`'s spline and fit settings for `genus`: its grid and that grid's smoothness.
+fn fit_settings(genus: u32) -> (SplineSettings, FitSettings) {
+    let spline = SplineSettings {
+        grid: default_grid(genus),
+        ..SplineSettings::default()
+    };
+    (spline, FitSettings::for_grid(spline.grid))
+}
+
 fn fit_parameters(genus: u32) -> String {
-    let s = SplineSettings::default();
-    let f = FitSettings::default();
+    let (s, f) = fit_settings(genus);
     format!(
-        "`embedding::fit::initial_model({genus}, {RESOLUTION}, SplineSettings::default(), \
-         FitSettings::default())` (degree {}, C^{} blends, {}×{} control grid per chart, \
-         smoothness {})",
+        "`embedding::fit::initial_model({genus}, {RESOLUTION}, …)` with `ntori new`'s defaults \
+         (degree {}, C^{} blends, {}×{} control grid per chart, smoothness {})",
         s.degree, s.continuity, s.grid, s.grid, f.smoothness
     )
 }
