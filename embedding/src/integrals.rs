@@ -92,17 +92,16 @@ pub fn surface_integrals(
                 if !chart.domain().contains(w) {
                     continue;
                 }
-                let p = ChartPoint::new(chart.id(), w);
-                let reps = layout.atlas().locate_with_transitions(p);
-                let own = layout
-                    .blends_located(&reps)
-                    .into_iter()
-                    .find(|b| b.0 == chart.id())
-                    .map_or(0.0, |b| b.1);
-                if own == 0.0 {
+                // The chart's own raw blend first: where it vanishes the point adds nothing, and
+                // elsewhere its normalised blend is it over the sum the evaluation forms anyway.
+                let raw = layout.raw_blend_value(chart.domain(), w);
+                if raw == 0.0 {
                     continue;
                 }
-                let s = layout.eval_located(control, p, &reps);
+                let p = ChartPoint::new(chart.id(), w);
+                let reps = layout.atlas().locate_with_transitions(p);
+                let (s, sum) = layout.eval_located_with_sum(control, p, &reps);
+                let own = raw / sum;
                 let da = s.area_element() * wx * wy * own;
                 let k = s.gaussian_curvature();
                 sums.gaussian_curvature += k * da;

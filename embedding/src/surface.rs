@@ -346,8 +346,7 @@ impl<'a> Layout<'a> {
         let raw: Vec<f64> = reps
             .iter()
             .map(|(r, _)| {
-                self.raw_blend(self.atlas.charts()[r.chart.index()].domain(), r.coords)
-                    .val
+                self.raw_blend_value(self.atlas.charts()[r.chart.index()].domain(), r.coords)
             })
             .collect();
         let total: f64 = raw.iter().sum();
@@ -399,6 +398,18 @@ impl<'a> Layout<'a> {
         p: ChartPoint,
         reps: &[(ChartPoint, Lft)],
     ) -> SurfaceJet {
+        self.eval_located_with_sum(control, p, reps).0
+    }
+
+    /// [`Layout::eval_located`] and the normalising sum Σ b_c of the raw blends there (the same
+    /// sum [`Layout::blends_located`] divides by, in the same order, so the same bits): a chart's
+    /// normalised blend is then its raw blend over it, without locating or blending again.
+    pub(crate) fn eval_located_with_sum(
+        &self,
+        control: &[Point3],
+        p: ChartPoint,
+        reps: &[(ChartPoint, Lft)],
+    ) -> (SurfaceJet, f64) {
         let p1 = self.settings.degree + 1;
         let mut numerator = [Jet::default(); 3];
         let mut denominator = Jet::default();
@@ -444,14 +455,15 @@ impl<'a> Layout<'a> {
         }
         let [x, y, z] = numerator.map(|n| Jet::quotient(n, denominator));
         let v = |f: fn(&Jet) -> f64| Vector3::new(f(&x), f(&y), f(&z));
-        SurfaceJet {
+        let jet = SurfaceJet {
             pos: Point3::from(v(|j| j.val)),
             du: v(|j| j.du),
             dv: v(|j| j.dv),
             duu: v(|j| j.duu),
             duv: v(|j| j.duv),
             dvv: v(|j| j.dvv),
-        }
+        };
+        (jet, denominator.val)
     }
 }
 
