@@ -305,21 +305,26 @@ pub const DEFAULT_RESOLUTION: usize = 32;
 /// ([`SplineSettings::default`]) for the sphere, the torus and genus 2, 48 from genus 3 on (with
 /// [`default_smoothness`]'s stronger weight there). The plates' flat faces ripple where a chart's
 /// grid is too coarse for the map, which the coarse rims make anisotropic (σ₁/σ₂ 2.5–2.7 on
-/// average), and the inside chart carries more of the plate as the genus grows. Measured (release,
-/// `ntori new` and the shape_report example; patch disagreement, largest |κ| against the input's,
-/// normals from the intended shape at the 90th percentile; issue 12's targets 0.2%, 1.5×, 1°):
+/// average), and the inside chart carries more of the plate as the genus grows. Measured with
+/// `ntori new` (release; patch disagreement, largest |κ| against the input's, normals from the
+/// intended shape at the 90th percentile; issue 12's targets 0.2%, 1.5×, 1°; genus 2 at 48 with
+/// the shape_report example):
 ///
 /// | genus | grid 32, λ = 1e-4 | grid 48, λ = 2e-3 |
 /// |---|---|---|
 /// | 2 | 0.150%, 1.17×, 0.72° | 0.044%, 1.21×, 0.36° |
-/// | 3 | 0.188%, 1.57×, 1.00° | 0.090%, 1.42×, 0.51° |
-/// | 5 | 0.276%, 1.64×, 1.36° | 0.131%, 1.44×, 0.58° |
-/// | 10 | 0.201%, 2.13×, 1.39° | 0.084%, 1.30×, 0.73° |
+/// | 3 | 0.188%, 1.57×, 1.00° | 0.087%, 1.40×, 0.51° |
+/// | 5 | 0.276%, 1.57×, 1.36° | 0.131%, 1.36×, 0.58° |
+/// | 10 | 0.201%, 2.13×, 1.39° | 0.084%, 1.29×, 0.73° |
+/// | 16 | 0.016%, 1.64×, 1.25° | 0.004%, 1.30×, 0.76° |
+///
+/// Genus 20 and 24 pass every check at 48 as well (largest |κ| 1.21× and 1.27×, normals 0.66° and
+/// 0.65°; Gauss–Bonnet 9.2e-5 and 1.2e-4).
 ///
 /// Genus 2 keeps 32: it meets those targets there, and a finer grid costs the editor's brushes
-/// (2.25 times the control points under a brush). Before this, 40 from genus 21 on: at 32 genus 24
-/// missed Gauss–Bonnet by 7% and crossed itself (K spiked between samples); genus 32 fails at 32
-/// and at 48 alike.
+/// (2.25 times the control points under a brush). At 32 genus 24 missed Gauss–Bonnet by 7% and
+/// crossed itself (K spiked between samples); genus 32 failed at 32 and at 48 alike (before the
+/// stronger smoothing; not measured since).
 pub fn default_grid(genus: u32) -> usize {
     if genus <= 2 {
         SplineSettings::default().grid
