@@ -1209,9 +1209,9 @@ pub fn fit(
     for (r, p) in points.iter().enumerate() {
         let scale = (weights[r] / mean_weight).sqrt();
         row_weights.clear();
-        layout.weights(*p, &mut row_weights);
-        for w in &row_weights {
-            triplets.push(Triplet::new(r, w.control as usize, scale * w.jet.val));
+        layout.weight_values(*p, &mut row_weights);
+        for &(control, weight) in &row_weights {
+            triplets.push(Triplet::new(r, control as usize, scale * weight));
         }
     }
     let mut data_rows = points.len();

@@ -322,6 +322,34 @@ impl<'a> Layout<'a> {
         sum
     }
 
+    /// [`Layout::weights`]' values alone, bit for bit (the same products in the same order),
+    /// without their derivatives: (control point, weight) appended to `out`. Returns Σ b_c. The
+    /// fit's data rows need no more, and forming the second-order jets of every weight was most of
+    /// their assembly.
+    pub fn weight_values(&self, p: ChartPoint, out: &mut Vec<(u32, f64)>) -> f64 {
+        let p1 = self.settings.degree + 1;
+        let start = out.len();
+        let mut sum = 0.0;
+        for (rep, _) in self.atlas.locate_with_transitions(p) {
+            let chart = &self.atlas.charts()[rep.chart.index()];
+            let w = rep.coords;
+            let raw = self.raw_blend_value(chart.domain(), w);
+            sum += raw;
+            let (fu, nu) = self.basis.values(w.re);
+            let (fv, nv) = self.basis.values(w.im);
+            for (j, y) in nv[..p1].iter().enumerate() {
+                for (i, x) in nu[..p1].iter().enumerate() {
+                    let control = self.control_index(rep.chart, fu + i, fv + j) as u32;
+                    out.push((control, raw * (x * y)));
+                }
+            }
+        }
+        for weight in &mut out[start..] {
+            weight.1 /= sum;
+        }
+        sum
+    }
+
     /// The unblended patch E_c at a point of chart c: each of its (degree + 1)² live control points
     /// with its basis value (appended to `out`).
     pub fn patch_weights(&self, p: ChartPoint, out: &mut Vec<(u32, f64)>) {

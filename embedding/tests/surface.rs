@@ -490,6 +490,34 @@ proptest! {
         }
         prop_assert_eq!(Stencil::build_parallel(&layout, &points), stencil);
     }
+
+    /// `Layout::weight_values` (the fit's data rows) gives `Layout::weights`' values bit for bit,
+    /// control point by control point in the same order, and the same normalising sum.
+    #[test]
+    fn weight_values_are_the_weights_values_bit_for_bit(
+        genus in prop::sample::select(vec![0u32, 1, 2, 3, 5, 8, 16]),
+        degree in 1usize..=5,
+        grid in 8usize..=48,
+        continuity in 1usize..=4,
+        units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..200),
+    ) {
+        let atlas = atlas(genus);
+        let settings = SplineSettings { degree, grid, continuity };
+        let layout = Layout::new(atlas, settings).unwrap();
+        let mut points: Vec<ChartPoint> = units.iter().map(|&(a, b, c)| chart_point(atlas, a, b, c)).collect();
+        points.extend_from_slice(&atlas.tessellate(2, 2).unwrap().vertices);
+        let (mut jets, mut values) = (Vec::new(), Vec::new());
+        for &p in &points {
+            jets.clear();
+            values.clear();
+            let sum = layout.weights(p, &mut jets);
+            let value_sum = layout.weight_values(p, &mut values);
+            prop_assert_eq!(sum.val.to_bits(), value_sum.to_bits());
+            let expected: Vec<(u32, u64)> = jets.iter().map(|w| (w.control, w.jet.val.to_bits())).collect();
+            let got: Vec<(u32, u64)> = values.iter().map(|&(c, v)| (c, v.to_bits())).collect();
+            prop_assert_eq!(got, expected, "at {:?}", p);
+        }
+    }
 }
 
 #[test]
