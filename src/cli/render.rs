@@ -11,7 +11,8 @@ use super::{spinner, write_stdout};
 /// Render a model to a PNG picture, without a window.
 ///
 /// Uses the GPU if there is one, and otherwise Mesa's software Vulkan (lavapipe; on Debian or
-/// Ubuntu: apt-get install mesa-vulkan-drivers). The surface is tessellated at t_e = t_r = T and
+/// Ubuntu: apt-get install mesa-vulkan-drivers). The surface is tessellated at t_e = t_r = T (by
+/// default 32, or 64 from genus 8 on, whose t = 32 triangles are coarse on the outer rim) and
 /// evaluated exactly at the vertices, with analytic normals. Styles:
 ///   shaded      lit surface;
 ///   wireframe   the tessellation's edges over the shading (try a small T);
@@ -48,10 +49,10 @@ pub struct Args {
     /// Which curvature the curvature style shows.
     #[arg(long, value_enum, default_value_t = CurvatureArg::Gaussian)]
     curvature: CurvatureArg,
-    /// Tessellation t_e = t_r (1 to 256).
-    #[arg(long, default_value_t = 32, value_name = "T",
-          value_parser = clap::value_parser!(u32).range(1..=256))]
-    tessellation: u32,
+    /// Tessellation t_e = t_r (1 to 256) [default: 32, or 64 from genus 8 on where that makes at
+    /// most 1.5 million triangles]
+    #[arg(long, value_name = "T", value_parser = clap::value_parser!(u32).range(1..=256))]
+    tessellation: Option<u32>,
     /// Print nothing on success.
     #[arg(short, long)]
     quiet: bool,
@@ -91,15 +92,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             CurvatureArg::Mean => CurvatureKind::Mean,
         }),
     };
+    ntori::io::atomic::check_output(&output, &[&model])?;
+    let loaded = ntori::io::model_file::load(&model)?;
     let options = RenderOptions {
         width: size.0,
         height: size.1,
         view,
         style,
-        tessellation,
+        tessellation: tessellation
+            .unwrap_or_else(|| ntori::render::default_tessellation(loaded.genus())),
     };
-    ntori::io::atomic::check_output(&output, &[&model])?;
-    let loaded = ntori::io::model_file::load(&model)?;
     let bar = spinner(quiet);
     bar.set_message("opening the graphics adapter");
     let mut offscreen = ntori::render::Offscreen::new()?;

@@ -152,6 +152,22 @@ impl Default for RenderOptions {
     }
 }
 
+/// The tessellation `ntori render` draws a model of `genus` at where none is chosen: 32, or 64
+/// from genus 8 on where that stays within [`DEFAULT_MAX_TRIANGLES`]. At high genus the
+/// t = 32 tessellation's triangles grow large on the plates' outer rim, and their chords showed as
+/// notches in its silhouette (genus 10 and 16) where the surface is within 0.02% of the diagonal
+/// of the intended rim (the `rim_report` example); at 64 they all but go.
+pub fn default_tessellation(genus: u32) -> u32 {
+    const FINE: u32 = 64;
+    let fits = charts::Tessellation::expected_triangles(genus, FINE, FINE) <= DEFAULT_MAX_TRIANGLES;
+    if genus >= 8 && fits { FINE } else { 32 }
+}
+
+/// The most triangles [`default_tessellation`] chooses: genus 16 at t = 64 has 1.3 million (genus 8 to 18 get 64),
+/// which lavapipe draws at 1024 × 768 in a few seconds and whose vertex buffer stays well inside
+/// wgpu's default 256 MiB limit.
+pub const DEFAULT_MAX_TRIANGLES: u64 = 1_500_000;
+
 /// A polyline on the surface, drawn on top of it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Curve {

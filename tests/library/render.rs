@@ -285,3 +285,27 @@ fn gpu_reembedding_equals_the_cpu_to_a_millionth_of_the_diagonal() {
         }
     }
 }
+
+/// `ntori render`'s default tessellation: finer from genus 8 on, where t = 32 is coarse on the outer
+/// rim, but never past its triangle budget, so every genus renders by default.
+#[test]
+fn the_default_tessellation_is_finer_at_high_genus_within_its_budget() {
+    use ntori::render::{DEFAULT_MAX_TRIANGLES, MAX_TRIANGLES, default_tessellation};
+    for genus in 0..=charts::MAX_GENUS {
+        let t = default_tessellation(genus);
+        let triangles = charts::Tessellation::expected_triangles(genus, t, t);
+        assert!(t == 32 || t == 64, "genus {genus}: {t}");
+        assert!(t == 32 || genus >= 8, "genus {genus}: {t}");
+        assert!(
+            t == 32 || triangles <= DEFAULT_MAX_TRIANGLES,
+            "genus {genus}: {triangles}"
+        );
+        assert!(triangles <= MAX_TRIANGLES, "genus {genus}: {triangles}");
+    }
+    for genus in [0, 1, 2, 3, 7] {
+        assert_eq!(default_tessellation(genus), 32, "genus {genus}");
+    }
+    for genus in [8, 10, 16] {
+        assert_eq!(default_tessellation(genus), 64, "genus {genus}");
+    }
+}
