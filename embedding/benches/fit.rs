@@ -12,7 +12,7 @@
 //! In test mode (`cargo test --benches`) each runs once, on meshes a quarter as fine.
 
 use criterion::{BenchmarkId, Criterion};
-use embedding::fit::{FitSettings, default_grid, initial_model};
+use embedding::fit::{FitSettings, default_settings, initial_model};
 use embedding::holed::HoledMesh;
 use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
 use embedding::{Point3, SplineSettings};
@@ -33,12 +33,7 @@ fn initial_fit(c: &mut Criterion) {
     group.sample_size(10);
     for genus in [2u32, 5, 10] {
         group.bench_with_input(BenchmarkId::from_parameter(genus), &genus, |b, &g| {
-            // `ntori new`'s grid and smoothness for the genus.
-            let spline = SplineSettings {
-                grid: default_grid(g),
-                ..SplineSettings::default()
-            };
-            let settings = FitSettings::for_grid(spline.grid);
+            let (spline, settings) = default_settings(g);
             b.iter(|| initial_model(g, 32, spline, settings).unwrap())
         });
     }

@@ -351,6 +351,16 @@ pub fn default_smoothness(grid: usize) -> f64 {
     }
 }
 
+/// `ntori new`'s spline and fit settings for `genus` where none are chosen: the default degree and
+/// continuity, [`default_grid`], and that grid's [`default_smoothness`].
+pub fn default_settings(genus: u32) -> (SplineSettings, FitSettings) {
+    let spline = SplineSettings {
+        grid: default_grid(genus),
+        ..SplineSettings::default()
+    };
+    (spline, FitSettings::for_grid(spline.grid))
+}
+
 impl FitSettings {
     /// The defaults, with [`default_smoothness`] for `grid`.
     pub fn for_grid(grid: usize) -> FitSettings {

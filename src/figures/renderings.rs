@@ -6,8 +6,8 @@
 
 use charts::{ChartPoint, ModelPoint};
 use embedding::edit::{Constraint, solve};
-use embedding::fit::{FitSettings, InitialFit, default_grid, initial_model};
-use embedding::{Point3, SplineSettings, Surface, Vector3, bounding_box};
+use embedding::fit::{InitialFit, default_settings, initial_model};
+use embedding::{Point3, Surface, Vector3, bounding_box};
 
 use super::geometry::side_points;
 use super::{Figure, FiguresError, GENUS, palette};
@@ -40,7 +40,7 @@ impl Studio {
         if let Some(k) = self.fits.iter().position(|(g, _)| *g == genus) {
             return Ok(&self.fits[k].1);
         }
-        let (spline, settings) = fit_settings(genus);
+        let (spline, settings) = default_settings(genus);
         let fit = initial_model(genus, RESOLUTION, spline, settings).map_err(|source| {
             FiguresError::Embedding {
                 figure: figure.to_owned(),
@@ -102,17 +102,8 @@ fn describe(o: &RenderOptions) -> String {
     )
 }
 
-/// `ntori new`'s spline and fit settings for `genus`: its grid and that grid's smoothness.
-fn fit_settings(genus: u32) -> (SplineSettings, FitSettings) {
-    let spline = SplineSettings {
-        grid: default_grid(genus),
-        ..SplineSettings::default()
-    };
-    (spline, FitSettings::for_grid(spline.grid))
-}
-
 fn fit_parameters(genus: u32) -> String {
-    let (s, f) = fit_settings(genus);
+    let (s, f) = default_settings(genus);
     format!(
         "`embedding::fit::initial_model({genus}, {RESOLUTION}, …)` with `ntori new`'s defaults \
          (degree {}, C^{} blends, {}×{} control grid per chart, smoothness {})",

@@ -413,7 +413,7 @@ fn a_grid_far_finer_than_the_data_is_still_solved() {
 /// finer grid gets a stronger smoothness weight unless one is chosen.
 #[test]
 fn the_default_grid_is_32_up_to_genus_2_and_finer_above_with_more_smoothing() {
-    use embedding::fit::{FINE_GRID, default_grid, default_smoothness};
+    use embedding::fit::{FINE_GRID, default_grid, default_settings, default_smoothness};
     for genus in 0..=2 {
         assert_eq!(
             default_grid(genus),
@@ -433,6 +433,16 @@ fn the_default_grid_is_32_up_to_genus_2_and_finer_above_with_more_smoothing() {
         FitSettings::for_grid(FINE_GRID).smoothness,
         default_smoothness(FINE_GRID)
     );
+    // What `new` fits with where nothing is chosen: the grid, its smoothness, the other defaults.
+    for genus in [0, 2, 3, 24] {
+        let (spline, fit) = default_settings(genus);
+        assert_eq!(spline.grid, default_grid(genus), "genus {genus}");
+        assert_eq!((spline.degree, spline.continuity), {
+            let d = SplineSettings::default();
+            (d.degree, d.continuity)
+        });
+        assert_eq!(fit, FitSettings::for_grid(spline.grid), "genus {genus}");
+    }
 }
 
 /// Without a chosen resolution, high genus gets nearly the finest mesh within the default budget,
