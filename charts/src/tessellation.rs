@@ -4,8 +4,10 @@
 //! neighbouring squares meet at the point β (and its images about the 4n corners); what the squares
 //! leave is two "wheels", one about the inside chart's centre and one about the vertex, each bounded by
 //! 4n arcs (square sides a = ±s face the inside wheel, b = ±s the vertex wheel). Then t_e divides each
-//! square into a t_e × t_e grid and each arc into t_e pieces; t_r divides each wheel's spokes. Genus 0
-//! has no squares: two wheels (the caps) meet along the equator, divided into 4·t_e arcs.
+//! square into a t_e × t_e grid and each arc into t_e pieces; t_r divides each wheel's spokes, in
+//! steps that shrink toward the rim where the rim's vertices are closer than t_r's even step (from
+//! genus 2; see `SpokeGrading`: the paper's even steps make slivers at high genus). Genus 0 has no
+//! squares: two wheels (the caps) meet along the equator, divided into 4·t_e arcs.
 //!
 //! Counts, with n the genus, e = t_e, r = t_r (tested):
 //! - genus ≥ 1: V = 2n(e² + 2e − 1) + 2 + 8n·e(r − 1), F = 4n·e² + 8n·e(2r − 1), E = 3F/2;
@@ -151,13 +153,14 @@ impl Builder<'_> {
             .collect::<Result<_, ChartsError>>()?;
         ring.sort_by(|a, b| a.1.arg().total_cmp(&b.1.arg()));
         let tr = self.t.tr;
+        let spoke = SpokeGrading::for_wheel(&ring, tr);
         let centre = self.vertex(ChartPoint::new(chart, Complex64::ZERO));
         let mut inner: Vec<(u32, Complex64)> = Vec::new();
         for r in 1..=tr {
             let outer: Vec<(u32, Complex64)> = if r == tr {
                 ring.clone()
             } else {
-                let f = f64::from(r) / f64::from(tr);
+                let f = spoke.fraction(f64::from(r) / f64::from(tr));
                 ring.iter()
                     .map(|&(_, w)| (self.vertex(ChartPoint::new(chart, w * f)), w * f))
                     .collect()
@@ -198,6 +201,54 @@ impl Builder<'_> {
             inner = outer;
         }
         Ok(())
+    }
+}
+
+/// Where a wheel's rings lie along its spokes: ring r of t_r at the fraction f(r / t_r) of the way
+/// from the centre to the rim, with f(s) = (2 − λ)s + (λ − 1)s², so f(0) = 0, f(1) = 1 and the
+/// last step is λ times the even step.
+///
+/// Why: the rim carries 4n·t_e vertices, so at even steps (λ = 1) the outer band's triangles are
+/// about 4n/2π times longer along the spoke than across it (6:1 at genus 10, 10:1 at genus 16),
+/// and where the surface is strongly curved across the band such slivers bend sharply and do not
+/// halve when t_r doubles. λ is chosen so the last step matches the rim's mean vertex spacing, but
+/// never below [`SpokeGrading::MIN_LAST_STEP`] (the innermost step is 2 − λ times the even step, so
+/// it stays under twice it) nor below 2/(t_r + 2) (neighbouring steps within a factor 2). At genus
+/// 0 and 1 the rim is coarse enough that λ = 1: the paper's even steps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct SpokeGrading {
+    last_step: f64,
+}
+
+impl SpokeGrading {
+    /// The smallest λ: the rim's step at least a tenth of the even step.
+    const MIN_LAST_STEP: f64 = 0.1;
+
+    /// The grading for a wheel with these rim vertices (sorted by angle, in the wheel's chart)
+    /// and `tr` divisions of each spoke.
+    fn for_wheel(rim: &[(u32, Complex64)], tr: u32) -> Self {
+        let m = rim.len();
+        if m < 2 || tr < 2 {
+            return SpokeGrading { last_step: 1.0 };
+        }
+        let radius = rim.iter().map(|(_, w)| w.norm()).sum::<f64>() / m as f64;
+        let spacing = (0..m)
+            .map(|k| (rim[(k + 1) % m].1 - rim[k].1).norm())
+            .sum::<f64>()
+            / m as f64;
+        let even_step = radius / f64::from(tr);
+        // Near the rim the steps grow by 1 + 2(1 − λ)/(λ t_r) from one ring to the next; a
+        // smallest λ of 2/(t_r + 2) keeps that growth within 2 at low t_r.
+        let smallest = Self::MIN_LAST_STEP.max(2.0 / f64::from(tr + 2));
+        SpokeGrading {
+            last_step: (spacing / even_step).clamp(smallest, 1.0),
+        }
+    }
+
+    /// The fraction of the spoke at `s` = r / t_r.
+    fn fraction(&self, s: f64) -> f64 {
+        let lambda = self.last_step;
+        (2.0 - lambda) * s + (lambda - 1.0) * s * s
     }
 }
 

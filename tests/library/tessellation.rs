@@ -187,3 +187,39 @@ fn bad_resolutions_are_errors() {
         );
     }
 }
+
+/// The wheels' outermost band: each triangle with a side on the rim, its height across that side
+/// over the side's length, in its home chart. The paper's even spoke steps make this about 4n/2π at
+/// t_e = t_r (slivers 6:1 at genus 10, which bend sharply once mapped onto a curved rim); the
+/// graded steps bring it to about 1 wherever the smallest last step allows (to genus 15 at 32).
+#[test]
+fn the_wheels_outer_band_is_not_a_band_of_slivers() {
+    for genus in [2, 3, 5, 8, 10, 16, 32, 64] {
+        let atlas = Atlas::new(genus).unwrap();
+        for t in [8, 16, 32] {
+            let tess = atlas.tessellate(t, t).unwrap();
+            let mut aspects: Vec<f64> = (0..tess.triangles.len())
+                .filter(|&k| tess.triangle_regions[k] != charts::Region::Square)
+                .filter_map(|k| {
+                    let c = tess.triangle_coords[k];
+                    let side =
+                        (0..3).find(|&i| tess.triangle_edge_labels[k][i] != charts::EDGE_INNER)?;
+                    let rim = (c[(side + 1) % 3] - c[side]).norm();
+                    let doubled_area = ((c[1] - c[0]).conj() * (c[2] - c[0])).im;
+                    Some(doubled_area / rim / rim)
+                })
+                .collect();
+            aspects.sort_by(f64::total_cmp);
+            let median = aspects[aspects.len() / 2];
+            let even = 4.0 * f64::from(genus) / (2.0 * PI);
+            // λ's floor: 0.1, or 2/(t + 2) at low t.
+            let floor = 0.1f64.max(2.0 / f64::from(t + 2));
+            let want = (floor * even).max(1.0) * 1.5;
+            assert!(
+                median <= want && median >= 0.4,
+                "genus {genus}, t {t}: the rim band's median height over width is {median:.2} \
+                 (even steps: about {even:.2}; want at most {want:.2})"
+            );
+        }
+    }
+}
