@@ -6,8 +6,10 @@
 //! 4n arcs (square sides a = ±s face the inside wheel, b = ±s the vertex wheel). Then t_e divides each
 //! square into a t_e × t_e grid and each arc into t_e pieces; t_r divides each wheel's spokes, in
 //! steps that shrink toward the rim where the rim's vertices are closer than t_r's even step (from
-//! genus 2; see `SpokeGrading`: the paper's even steps make slivers at high genus). Genus 0 has no
-//! squares: two wheels (the caps) meet along the equator, divided into 4·t_e arcs.
+//! genus 2; see `SpokeGrading`), and each ring fades out the rim's star points (see
+//! `smoothed_rim_radii`): the paper's even steps and rings copied from the rim make slivers at
+//! high genus. Genus 0 has no squares: two wheels (the caps) meet along the equator, divided into
+//! 4·t_e arcs.
 //!
 //! Counts, with n the genus, e = t_e, r = t_r (tested):
 //! - genus ≥ 1: V = 2n(e² + 2e − 1) + 2 + 8n·e(r − 1), F = 4n·e² + 8n·e(2r − 1), E = 3F/2;
@@ -154,15 +156,22 @@ impl Builder<'_> {
         ring.sort_by(|a, b| a.1.arg().total_cmp(&b.1.arg()));
         let tr = self.t.tr;
         let spoke = SpokeGrading::for_wheel(&ring, tr);
+        let smoothed = smoothed_rim_radii(&ring, self.t.te.div_ceil(4) as usize);
         let centre = self.vertex(ChartPoint::new(chart, Complex64::ZERO));
         let mut inner: Vec<(u32, Complex64)> = Vec::new();
         for r in 1..=tr {
             let outer: Vec<(u32, Complex64)> = if r == tr {
                 ring.clone()
             } else {
-                let f = spoke.fraction(f64::from(r) / f64::from(tr));
+                let s = f64::from(r) / f64::from(tr);
+                let (f, kept) = (spoke.fraction(s), s.powi(RIM_POINTS_KEPT_POWER));
                 ring.iter()
-                    .map(|&(_, w)| (self.vertex(ChartPoint::new(chart, w * f)), w * f))
+                    .zip(&smoothed)
+                    .map(|(&(_, w), &smooth)| {
+                        let radius = w.norm();
+                        let z = w / radius * (f * (kept * radius + (1.0 - kept) * smooth));
+                        (self.vertex(ChartPoint::new(chart, z)), z)
+                    })
                     .collect()
             };
             let m = outer.len();
@@ -202,6 +211,36 @@ impl Builder<'_> {
         }
         Ok(())
     }
+}
+
+/// How much of the rim's points an inner ring keeps: s^p at s = r / t_r of the way out (see
+/// [`smoothed_rim_radii`]).
+const RIM_POINTS_KEPT_POWER: i32 = 3;
+
+/// The rim's radius at each rim vertex averaged over `half_window` rim vertices either side, or the
+/// vertex's own where that is less (so no inner ring reaches past the rim).
+///
+/// Why: the rim is a star whose 4n points (the images of β) stick out, and its arcs meet them at
+/// about 45° to the spokes. Rings that are scaled copies of the rim copy the points, and every band
+/// has a triangle with an angle of about 135° there, far flatter once mapped into space (the
+/// genus-3 plate had 112 triangles with an angle ≥ 170° at t_e = t_r = 32). Ring r takes the
+/// fraction (r / t_r)^p of the rim's own radius and the rest of this smoothed one, so the points
+/// fade inward; a fixed fraction of the way out, so the band next to the rim is still thin (it
+/// shrinks with t_r rather than keeping the points' height; a ring that dropped the points at once
+/// left an edge as long as they are high, whose bend did not halve when t_r doubled).
+fn smoothed_rim_radii(rim: &[(u32, Complex64)], half_window: usize) -> Vec<f64> {
+    let m = rim.len();
+    let radius = |j: usize| rim[j % m].1.norm();
+    let half_window = half_window.min(m.saturating_sub(1) / 2);
+    (0..m)
+        .map(|j| {
+            let mean = (m + j - half_window..=m + j + half_window)
+                .map(radius)
+                .sum::<f64>()
+                / (2 * half_window + 1) as f64;
+            mean.min(radius(j))
+        })
+        .collect()
 }
 
 /// Where a wheel's rings lie along its spokes: ring r of t_r at the fraction f(r / t_r) of the way

@@ -223,3 +223,40 @@ fn the_wheels_outer_band_is_not_a_band_of_slivers() {
         }
     }
 }
+
+/// The wheels' triangles, in their home chart: few have an angle above 120°, and almost none above
+/// 130°. Rings that were scaled copies of the rim copied its star points into every band (22–35% of
+/// the wheels' triangles above 120°, 6–11% above 130°: these became the triangles of 170° and more
+/// once mapped onto the plates' rims); the rings now fade the points out (at most 3.5% and 0.25%).
+#[test]
+fn the_wheels_have_few_obtuse_triangles() {
+    for genus in [2, 3, 5, 10, 16, 32, 64] {
+        let atlas = Atlas::new(genus).unwrap();
+        for t in [8, 16, 32] {
+            let tess = atlas.tessellate(t, t).unwrap();
+            let largest: Vec<f64> = (0..tess.triangles.len())
+                .filter(|&k| tess.triangle_regions[k] != charts::Region::Square)
+                .map(|k| {
+                    let c = tess.triangle_coords[k];
+                    (0..3)
+                        .map(|j| {
+                            let (a, b) = (c[(j + 1) % 3] - c[j], c[(j + 2) % 3] - c[j]);
+                            (a.conj() * b).arg().abs().to_degrees()
+                        })
+                        .fold(0.0, f64::max)
+                })
+                .collect();
+            let share = |above: f64| {
+                largest.iter().filter(|&&a| a > above).count() as f64 / largest.len() as f64
+            };
+            let (over_120, over_130) = (share(120.0), share(130.0));
+            assert!(
+                over_120 <= 0.05 && over_130 <= 0.005,
+                "genus {genus}, t {t}: {:.1}% of the wheels' triangles have an angle above 120°, \
+                 {:.2}% above 130°",
+                100.0 * over_120,
+                100.0 * over_130
+            );
+        }
+    }
+}
