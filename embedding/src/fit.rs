@@ -323,8 +323,15 @@ pub const DEFAULT_RESOLUTION: usize = 32;
 ///
 /// Genus 2 keeps 32: it meets those targets there, and a finer grid costs the editor's brushes
 /// (2.25 times the control points under a brush). At 32 genus 24 missed Gauss–Bonnet by 7% and
-/// crossed itself (K spiked between samples); genus 32 failed at 32 and at 48 alike (before the
-/// stronger smoothing; not measured since).
+/// crossed itself (K spiked between samples).
+///
+/// Genus 32 fails at every grid tried. At 48 (λ = 2e-3), Gauss–Bonnet is off by 6.4e-2, the
+/// largest |κ| is 63× the input's and 97 triangle pairs cross at t = 64; at 40 it is worse. At 64
+/// every check passes but curvature (3.65×, and 4.19× with λ = 6e-3). The spike sits where the
+/// inside or the vertex chart (blend ≥ 0.89) carries the outer rim, at |z| ≈ 0.48, with
+/// |E_u| ≈ 70–80 against the edge charts' 3–6 (the `spot_report` example): there one grid cell
+/// spans about 2 model units, more than the rim's rounded edge. The lever is a finer grid in those
+/// two charts, or blends that hand the rim to the edge charts, not a finer grid everywhere.
 pub fn default_grid(genus: u32) -> usize {
     if genus <= 2 {
         SplineSettings::default().grid
