@@ -163,9 +163,9 @@ pub fn default_tessellation(genus: u32) -> u32 {
     if genus >= 8 && fits { FINE } else { 32 }
 }
 
-/// The most triangles [`default_tessellation`] chooses: genus 16 at t = 64 has 1.3 million (genus 8 to 18 get 64),
-/// which lavapipe draws at 1024 × 768 in a few seconds and whose vertex buffer stays well inside
-/// wgpu's default 256 MiB limit.
+/// The most triangles [`default_tessellation`] chooses: genus 16 at t = 64 has 1.3 million
+/// (genus 8 to 18 get 64), which lavapipe draws at 1024 × 768 in a few seconds and whose vertex
+/// buffer stays well inside wgpu's default 256 MiB limit.
 pub const DEFAULT_MAX_TRIANGLES: u64 = 1_500_000;
 
 /// A polyline on the surface, drawn on top of it.
