@@ -19,7 +19,18 @@ pub fn parameterize(
     triangles: &[[u32; 3]],
     boundary: &[(u32, [f64; 2])],
 ) -> Result<Vec<[f64; 2]>, EmbeddingError> {
-    let n = positions.len();
+    solve_pinned(&mean_value_weights(positions, triangles)?, boundary)
+}
+
+/// [`parameterize`] with the weights given: `weights[v]` lists v's neighbours with positive weights
+/// (not necessarily symmetric). Every free vertex becomes the weighted mean of its neighbours, so
+/// with a convex boundary the map is still a bijection (Floater's theorem asks only for positive
+/// weights): what lets a reweighted map keep that guarantee.
+pub fn solve_pinned(
+    weights: &[Vec<(u32, f64)>],
+    boundary: &[(u32, [f64; 2])],
+) -> Result<Vec<[f64; 2]>, EmbeddingError> {
+    let n = weights.len();
     if boundary.is_empty() {
         return Err(EmbeddingError::Parameterization(
             "no boundary vertices were given".into(),
@@ -41,7 +52,6 @@ pub fn parameterize(
             interior.push(v);
         }
     }
-    let weights = mean_value_weights(positions, triangles)?;
     let m = interior.len();
     let mut triplets = Vec::new();
     let mut rhs = Mat::<f64>::zeros(m, 2);

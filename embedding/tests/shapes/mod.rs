@@ -281,3 +281,35 @@ fn orient_outward(positions: &[Point3], triangles: &mut [[u32; 3]]) {
         }
     }
 }
+
+/// An animal of capsules (genus 0): a body 3 long, four legs 1.2 long and 0.16 thick, a neck and a
+/// head, smoothly joined. Its conformal map onto the sphere squeezes the legs' ends to specks, as a
+/// scanned cow's or a dog's does.
+pub fn animal(cell: f64) -> Mesh {
+    level_set(
+        &animal_field,
+        Point3::new(-2.2, -1.0, -1.6),
+        Point3::new(2.6, 1.0, 1.4),
+        cell,
+    )
+}
+
+fn animal_field(p: Point3) -> f64 {
+    let capsule = |a: [f64; 3], b: [f64; 3], r: f64| {
+        let (a, b) = (Vector3::from(a), Vector3::from(b));
+        let t = ((p.coords - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
+        (p.coords - (a + (b - a) * t)).norm() - r
+    };
+    let body = capsule([-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.45);
+    let legs = [(-0.9, -0.25), (-0.9, 0.25), (0.9, -0.25), (0.9, 0.25)]
+        .iter()
+        .map(|&(x, y)| capsule([x, y, -0.2], [x, y, -1.35], 0.16))
+        .fold(f64::INFINITY, f64::min);
+    let neck = capsule([1.1, 0.0, 0.1], [1.7, 0.0, 0.8], 0.2);
+    let head = capsule([1.6, 0.0, 0.85], [2.15, 0.0, 0.75], 0.25);
+    smooth_min(
+        smooth_min(body, legs, 0.12),
+        smooth_min(neck, head, 0.1),
+        0.12,
+    )
+}
