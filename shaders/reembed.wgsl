@@ -6,10 +6,20 @@
 struct Params {
     rows: u32,
     order: u32,
-    // Control points per side of a chart's grid: the stride between a block's lines.
+    // Control points per side of a square chart's grid: the stride between a block's lines.
     grid: u32,
     // u32 words per block: its first control point, then 2 · order factors as f32 bits.
     stride: u32,
+    // The disk charts' grid, and how many control points they hold (they come first).
+    disk_grid: u32,
+    disk_controls: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+// The stride between the lines of a block whose first control point is `first`.
+fn line_stride(first: u32) -> u32 {
+    return select(params.grid, params.disk_grid, first < params.disk_controls);
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -33,7 +43,7 @@ fn reembed(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups
         let b = k * params.stride;
         let first = blocks[b];
         for (var j = 0u; j < o; j++) {
-            let line = first + j * params.grid;
+            let line = first + j * line_stride(first);
             var s = vec4<f32>(0.0);
             for (var i = 0u; i < o; i++) {
                 s += bitcast<f32>(blocks[b + 1u + i]) * control[line + i];
@@ -66,7 +76,7 @@ fn reembed_with_tangents(@builtin(global_invocation_id) id: vec3<u32>, @builtin(
         var bu = vec4<f32>(0.0);
         var cv = vec4<f32>(0.0);
         for (var j = 0u; j < o; j++) {
-            let line = first + j * params.grid;
+            let line = first + j * line_stride(first);
             var s = vec4<f32>(0.0);
             var s1 = vec4<f32>(0.0);
             for (var i = 0u; i < o; i++) {

@@ -5,7 +5,9 @@
 use std::time::Instant;
 
 use embedding::SplineSettings;
-use embedding::fit::{FitSettings, default_grid, default_smoothness, initial_model};
+use embedding::fit::{
+    FitSettings, default_disk_grid, default_grid, default_smoothness, initial_model,
+};
 use embedding::quality::{
     max_principal_curvature, normal_deviation_from, patch_disagreement, sample_points,
 };
@@ -25,14 +27,19 @@ fn main() {
     );
     for genus in genera {
         let start = Instant::now();
-        // NTORI_GRID, NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override `ntori new`'s defaults, for
-        // tuning.
+        // NTORI_GRID, NTORI_DISK_GRID, NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override `ntori
+        // new`'s defaults, for tuning.
         let defaults = FitSettings::default();
         let setting = |name: &str, default: f64| {
             std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
         };
+        let grid = setting("NTORI_GRID", default_grid(genus) as f64) as usize;
         let spline = SplineSettings {
-            grid: setting("NTORI_GRID", default_grid(genus) as f64) as usize,
+            grid,
+            disk_grid: std::env::var("NTORI_DISK_GRID")
+                .map_or(default_disk_grid(genus, grid), |v| {
+                    Some(v.parse().expect("a grid"))
+                }),
             ..SplineSettings::default()
         };
         let settings = FitSettings {

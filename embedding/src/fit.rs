@@ -343,6 +343,45 @@ pub fn default_grid(genus: u32) -> usize {
 /// The grid [`default_grid`] gives from genus 3 on.
 pub const FINE_GRID: usize = 48;
 
+/// The disk charts' grid `ntori new` uses for `genus` and an edge-chart `grid` where none is
+/// chosen (`None`: the same as the edge charts'): twice `grid` from genus 3, 8/3 of it from genus
+/// 16 (96 and 128 at the default 48), rounded to a multiple of 8.
+///
+/// The inside and vertex charts are each a disk about a point whose hyperbolic neighbourhood
+/// holds well over half the surface: the plate's bottom and top faces and, at their rims, the
+/// sides of every hole nearest the centre and the outer rim between holes, where no edge chart
+/// reaches far. Their coordinates are the Poincaré disk's, scaled, so a grid cell at a disk
+/// chart's rim spans 1/(1 − r²) times what one at its centre does (r the image's radius: 0.76 at
+/// genus 3, 0.92 at genus 10, 0.98 at genus 32): at genus 32, |E_u| reached 70–80 there against
+/// the edge charts' 3–6, one cell spanned the rim's whole rounding, and the fit spiked. At
+/// genus 3 to 10 the same coarse rims drew the ripples on the flat faces beside the holes (the
+/// streaks of the mean-curvature pictures). There are only two disk charts against 2n edge
+/// charts, so a finer grid there costs little: at genus 10, 96 adds 27% control points and
+/// 0.5 s of fitting.
+///
+/// Measured with `ntori new` and the shape_report example (patch disagreement as % of the
+/// diagonal; largest |κ| against the input's; normals from the intended shape at the 90th
+/// percentile; flat faces' |H|·T at the 90th percentile; issue 12's targets 0.2%, 1.5×, 1°, 0.02):
+///
+/// | genus | disk grid 48 (the edge charts') | disk grid 96 | 128 |
+/// |---|---|---|---|
+/// | 3 | 0.087%, 1.40×, 0.51°, 0.029 | 0.023%, 1.42×, 0.38°, 0.016 | |
+/// | 5 | 0.131%, 1.37×, 0.58°, 0.044 | 0.027%, 1.44×, 0.40°, 0.021 | 0.017%, 0.019 |
+/// | 10 | 0.153%, 1.31×, 0.73°, 0.046 | 0.042%, 1.20×, 0.35°, 0.019 | |
+/// | 16 | 0.005%, 1.47×, 0.76°, 0.038 | 0.005%, 1.26×, 0.40° | 0.004%, 1.24×, 0.30° |
+/// | 32 | fails: Gauss–Bonnet 6.4e-2, 63× | | 0.015%, 1.89×, 0.47°; Gauss–Bonnet 3.2e-5 |
+///
+/// Genus 2 keeps its 32: its edge charts are the coarse ones there (a disk grid of 64 smoothed the
+/// flat faces, 0.026 → 0.013, but the patches' disagreement rose to 0.21%).
+pub fn default_disk_grid(genus: u32, grid: usize) -> Option<usize> {
+    let (num, den) = match genus {
+        0..=2 => return None,
+        3..=15 => (2, 1),
+        _ => (8, 3),
+    };
+    Some((grid * num).div_ceil(8 * den).max(1) * 8)
+}
+
 /// The smoothness weight λ for a control grid where none is chosen: [`FitSettings::default`]'s
 /// 1e-4 up to 32 per side, 2e-3 above. The second differences of a given surface's control grid
 /// shrink as the grid's spacing squared, so the same weight smooths a finer grid less (by
@@ -359,10 +398,12 @@ pub fn default_smoothness(grid: usize) -> f64 {
 }
 
 /// `ntori new`'s spline and fit settings for `genus` where none are chosen: the default degree and
-/// continuity, [`default_grid`], and that grid's [`default_smoothness`].
+/// continuity, [`default_grid`], [`default_disk_grid`], and that grid's [`default_smoothness`].
 pub fn default_settings(genus: u32) -> (SplineSettings, FitSettings) {
+    let grid = default_grid(genus);
     let spline = SplineSettings {
-        grid: default_grid(genus),
+        grid,
+        disk_grid: default_disk_grid(genus, grid),
         ..SplineSettings::default()
     };
     (spline, FitSettings::for_grid(spline.grid))
@@ -1360,9 +1401,9 @@ pub(crate) fn least_squares(
 /// Second differences of every chart's control grid: along u, along v, and the mixed difference
 /// (scaled by √2, so the sum of squares is the discrete thin-plate energy).
 pub(crate) fn smoothness_rows(layout: &Layout) -> Vec<Vec<(usize, f64)>> {
-    let g = layout.settings().grid;
     let mut rows = Vec::new();
     for chart in layout.atlas().charts() {
+        let g = layout.grid(chart.id());
         for j in 0..g {
             for i in 0..g {
                 smoothness_rows_at(layout, chart.id(), i, j, |row| rows.push(row.to_vec()));
@@ -1381,7 +1422,7 @@ pub(crate) fn smoothness_rows_at(
     j: usize,
     mut row: impl FnMut(&[(usize, f64)]),
 ) {
-    let g = layout.settings().grid;
+    let g = layout.grid(chart);
     let at = |i: usize, j: usize| layout.control_index(chart, i, j);
     if i + 2 < g {
         row(&[(at(i, j), 1.0), (at(i + 1, j), -2.0), (at(i + 2, j), 1.0)]);

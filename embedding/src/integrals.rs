@@ -72,22 +72,26 @@ pub fn surface_integrals(
     cells_per_knot: usize,
 ) -> SurfaceIntegrals {
     use rayon::prelude::*;
-    let settings = layout.settings();
-    let cells = (settings.grid - settings.degree) * cells_per_knot.max(1);
-    let h = 1.0 / cells as f64;
-    let rows: Vec<(&charts::Chart, f64, f64)> = layout
+    let degree = layout.settings().degree;
+    // A chart's cells follow its own grid, so a finer disk grid gets a finer rule.
+    let cells_of =
+        |chart: &charts::Chart| (layout.grid(chart.id()) - degree) * cells_per_knot.max(1);
+    let rows: Vec<(&charts::Chart, usize, f64, f64)> = layout
         .atlas()
         .charts()
         .iter()
-        .flat_map(|chart| nodes(cells, h).map(move |(y, wy)| (chart, y, wy)))
+        .flat_map(|chart| {
+            let cells = cells_of(chart);
+            nodes(cells, 1.0 / cells as f64).map(move |(y, wy)| (chart, cells, y, wy))
+        })
         .collect();
     // One row of Gauss points per task, summed in order afterwards: all cores, and the same sums
     // whatever the number of threads.
     let row_sums: Vec<SurfaceIntegrals> = rows
         .par_iter()
-        .map(|&(chart, y, wy)| {
+        .map(|&(chart, cells, y, wy)| {
             let mut sums = SurfaceIntegrals::default();
-            for (x, wx) in nodes(cells, h) {
+            for (x, wx) in nodes(cells, 1.0 / cells as f64) {
                 let w = Complex64::new(x, y);
                 if !chart.domain().contains(w) {
                     continue;

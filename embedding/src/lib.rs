@@ -40,10 +40,14 @@ pub mod stencil;
 pub mod surface;
 
 pub use evaluate::{Curvatures, Sample, SampleSink, Wants, evaluate, evaluate_rows};
-pub use model::{MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader, ModelPin, PINS_VERSION};
+pub use model::{
+    DISK_GRID_VERSION, MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader, ModelPin, PINS_VERSION,
+};
 pub use spline_surface::{ControlId, Surface};
 pub use stencil::{ColumnIndex, ControlFrame, Stencil, TensorStencil, tangent_words};
-pub use surface::{Jet, Layout, Point3, SplineSettings, SurfaceJet, Vector3, Weight, bounding_box};
+pub use surface::{
+    ControlGrids, Jet, Layout, Point3, SplineSettings, SurfaceJet, Vector3, Weight, bounding_box,
+};
 
 pub use charts;
 
@@ -64,6 +68,11 @@ pub enum EmbeddingError {
     FutureVersion { version: u32, supported: u32 },
     #[error("the model's genus or spline settings do not match the layout")]
     Mismatch,
+    #[error(
+        "the settings give the disk charts a grid of {grid}, which a version {version} model cannot hold (disk grids need version {need})",
+        need = model::DISK_GRID_VERSION
+    )]
+    DiskGridVersion { grid: usize, version: u32 },
     #[error("the model has {found} control points, its settings need {expected}")]
     ControlCount { found: usize, expected: usize },
     #[error("control point {0} has a coordinate that is not a finite number")]

@@ -7,11 +7,16 @@ use crate::surface::{Layout, Point3, SplineSettings};
 
 /// The file format's name, and the newest version this build reads and writes.
 pub const MODEL_FORMAT: &str = "ntori-model";
-pub const MODEL_VERSION: u32 = 2;
+pub const MODEL_VERSION: u32 = 3;
 
-/// The first version that holds pins. A model without pins is written as version 1, which every
-/// build reads; one with pins as version 2.
+/// The first version that holds pins. A model is written as the oldest version that holds what it
+/// has: version 1 (which every build reads) without pins or a disk grid, 2 with pins, 3 with a
+/// disk grid.
 pub const PINS_VERSION: u32 = 2;
+
+/// The first version whose settings may give the disk charts their own grid
+/// ([`SplineSettings::disk_grid`]).
+pub const DISK_GRID_VERSION: u32 = 3;
 
 /// A pinned surface point: a chart and coordinates in it (the editor holds pins in place while
 /// dragging). Part of the model since version 2.
@@ -71,12 +76,17 @@ impl ModelHeader {
 impl Model {
     /// A model whose every control point is `point` (so the surface is that point).
     pub fn constant(layout: &Layout, point: Point3) -> Model {
+        let settings = layout.settings();
         Model {
             format: MODEL_FORMAT.into(),
-            // Without pins, the version every build reads.
-            version: 1,
+            // Without pins, the version every build reads, unless the settings need a newer one.
+            version: if settings.disk_grid.is_some() {
+                DISK_GRID_VERSION
+            } else {
+                1
+            },
             genus: layout.atlas().genus(),
-            settings: layout.settings(),
+            settings,
             control_points: vec![[point.x, point.y, point.z]; layout.control_count()],
             pins: Vec::new(),
         }

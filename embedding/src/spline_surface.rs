@@ -11,9 +11,8 @@ use std::sync::Arc;
 use charts::{Atlas, ChartPoint, Lft};
 
 use crate::EmbeddingError;
-use crate::bspline::UniformBasis;
-use crate::model::{Model, ModelHeader, ModelPin, PINS_VERSION};
-use crate::surface::{Layout, Point3, SplineSettings, SurfaceJet};
+use crate::model::{DISK_GRID_VERSION, Model, ModelHeader, ModelPin, PINS_VERSION};
+use crate::surface::{Bases, Layout, Point3, SplineSettings, SurfaceJet};
 
 /// A control point's index in [`Layout`] order (chart-major, then row-major in the chart's grid).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
@@ -31,7 +30,7 @@ impl ControlId {
 pub struct Surface {
     atlas: Arc<Atlas>,
     settings: SplineSettings,
-    basis: UniformBasis,
+    bases: Bases,
     control: Vec<Point3>,
     /// Surface points the editor holds in place (each inside its chart's domain).
     pins: Vec<ChartPoint>,
@@ -54,11 +53,11 @@ impl Surface {
         settings: SplineSettings,
         control: Vec<Point3>,
     ) -> Result<Surface, EmbeddingError> {
-        let basis = Layout::new(&atlas, settings)?.basis();
+        let bases = Layout::new(&atlas, settings)?.bases();
         let surface = Surface {
             atlas,
             settings,
-            basis,
+            bases,
             control: Vec::new(),
             pins: Vec::new(),
         };
@@ -81,6 +80,14 @@ impl Surface {
                     "is in a version {} model; pins need version {PINS_VERSION}",
                     model.version
                 ),
+            });
+        }
+        if let Some(grid) = model.settings.disk_grid
+            && model.version < DISK_GRID_VERSION
+        {
+            return Err(EmbeddingError::DiskGridVersion {
+                grid,
+                version: model.version,
             });
         }
         let atlas = Arc::new(Atlas::new(model.genus)?);
@@ -110,12 +117,13 @@ impl Surface {
         Ok(surface)
     }
 
-    /// The model document of this surface: version 1 without pins (every build reads it), else
-    /// [`PINS_VERSION`].
+    /// The model document of this surface, in the oldest version that holds it: 1 without pins
+    /// or a disk grid (every build reads it), [`PINS_VERSION`] with pins,
+    /// [`crate::model::DISK_GRID_VERSION`] with a disk grid.
     pub fn to_model(&self) -> Model {
         let mut model = Model::from_points(&self.layout(), &self.control);
         if !self.pins.is_empty() {
-            model.version = PINS_VERSION;
+            model.version = model.version.max(PINS_VERSION);
             model.pins = self
                 .pins
                 .iter()
@@ -162,7 +170,7 @@ impl Surface {
         Ok(Surface {
             atlas: Arc::clone(&self.atlas),
             settings: self.settings,
-            basis: self.basis,
+            bases: self.bases,
             control,
             pins: self.pins.clone(),
         })
@@ -217,7 +225,7 @@ impl Surface {
 
     /// The layout of the control points over the atlas. Cannot fail: the settings were checked.
     pub fn layout(&self) -> Layout<'_> {
-        Layout::from_checked(&self.atlas, self.basis, self.settings)
+        Layout::from_checked(&self.atlas, self.bases, self.settings)
     }
 
     /// S and its first and second derivatives at `p`, in `p.chart`'s coordinates.
@@ -253,7 +261,7 @@ impl Surface {
     }
 
     fn check_points(&self, control: &[Point3]) -> Result<(), EmbeddingError> {
-        let expected = self.atlas.charts().len() * self.settings.grid * self.settings.grid;
+        let expected = self.layout().control_count();
         if control.len() != expected {
             return Err(EmbeddingError::ControlCount {
                 found: control.len(),

@@ -42,6 +42,40 @@ pub struct SplineSettings {
     pub continuity: usize,
     /// Control points per side of each chart's grid.
     pub grid: usize,
+    /// Control points per side of the disk charts' grids (the inside and vertex charts; the caps
+    /// of the sphere), where they differ from `grid`. Those two charts carry far more of a
+    /// high-genus surface than an edge chart, and their outer parts are coarse: a grid cell
+    /// there spans many times what it does in an edge chart (see `fit::default_disk_grid`).
+    /// Absent in files before version 3, which then mean `grid`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub disk_grid: Option<usize>,
+}
+
+impl SplineSettings {
+    /// Control points per side of the disk charts' grids.
+    pub fn disk_grid(&self) -> usize {
+        self.disk_grid.unwrap_or(self.grid)
+    }
+
+    /// The grids in words: "48×48 control grid per chart", or "48×48 control grid per edge
+    /// chart, 96×96 per disk chart".
+    pub fn grid_text(&self) -> String {
+        let g = self.grid;
+        match self.disk_grid {
+            Some(d) if d != g => {
+                format!("{g}×{g} control grid per edge chart, {d}×{d} per disk chart")
+            }
+            _ => format!("{g}×{g} control grid per chart"),
+        }
+    }
+
+    /// Control points per side of a chart's grid with this domain.
+    pub fn grid_for(&self, domain: Domain) -> usize {
+        match domain {
+            Domain::Disk => self.disk_grid(),
+            Domain::Square => self.grid,
+        }
+    }
 }
 
 impl Default for SplineSettings {
@@ -57,6 +91,7 @@ impl Default for SplineSettings {
             degree: 3,
             continuity: 2,
             grid: 32,
+            disk_grid: None,
         }
     }
 }
@@ -181,13 +216,88 @@ impl SurfaceJet {
     }
 }
 
-/// How control points are laid out over an atlas: one grid × grid patch per chart, chart-major,
-/// then row-major (index = chart·grid² + j·grid + i for basis i in u, j in v).
+/// How control points are laid out over an atlas: one g × g patch per chart (g the chart's grid:
+/// [`SplineSettings::grid_for`] its domain), chart-major, then row-major (index = the chart's
+/// offset + j·g + i for basis i in u, j in v). The disk charts come first in every atlas, so a
+/// chart's offset is a sum of two counts.
 #[derive(Clone, Debug)]
 pub struct Layout<'a> {
     atlas: &'a Atlas,
-    basis: UniformBasis,
+    bases: Bases,
     settings: SplineSettings,
+}
+
+/// How a layout numbers its control points: the square charts' and the disk charts' grids, how
+/// many of the atlas's first charts are disks, and how many charts there are. Copy, so stencils
+/// can keep it without the atlas.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ControlGrids {
+    pub square: usize,
+    pub disk: usize,
+    pub disks: usize,
+    pub charts: usize,
+}
+
+impl ControlGrids {
+    /// Control points per side of `chart`'s grid.
+    pub fn grid(&self, chart: ChartId) -> usize {
+        if chart.index() < self.disks {
+            self.disk
+        } else {
+            self.square
+        }
+    }
+
+    /// The index of `chart`'s first control point (the count of all of them for the chart one
+    /// past the last).
+    pub fn offset(&self, chart: ChartId) -> usize {
+        let c = chart.index();
+        let d2 = self.disk * self.disk;
+        if c <= self.disks {
+            c * d2
+        } else {
+            self.disks * d2 + (c - self.disks) * self.square * self.square
+        }
+    }
+
+    /// Every chart's control points.
+    pub fn count(&self) -> usize {
+        self.offset(ChartId(self.charts as u32))
+    }
+
+    /// The chart holding control point `c`, and c's place (i, j) in its grid.
+    pub fn locate(&self, c: usize) -> (ChartId, usize, usize) {
+        let in_disks = self.disks * self.disk * self.disk;
+        let (chart, local, g) = if c < in_disks {
+            let per = self.disk * self.disk;
+            (c / per, c % per, self.disk)
+        } else {
+            let per = self.square * self.square;
+            let rest = c - in_disks;
+            (self.disks + rest / per, rest % per, self.square)
+        };
+        (ChartId(chart as u32), local % g, local / g)
+    }
+
+    /// The grid of the chart holding control point `c`: the stride between the lines of a
+    /// block that starts at `c`.
+    #[inline]
+    pub fn stride(&self, c: usize) -> usize {
+        if c < self.disks * self.disk * self.disk {
+            self.disk
+        } else {
+            self.square
+        }
+    }
+}
+
+/// The B-spline bases of a layout's charts: one for the squares, one for the disks (the same
+/// where their grids are), and how many of the atlas's first charts are disks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Bases {
+    square: UniformBasis,
+    disk: UniformBasis,
+    disks: usize,
 }
 
 /// One control point's weight at a surface point: its index and the jet of its weight.
@@ -202,28 +312,72 @@ impl<'a> Layout<'a> {
         if !(1..=4).contains(&settings.continuity) {
             return Err(EmbeddingError::Continuity(settings.continuity));
         }
+        let disks = atlas
+            .charts()
+            .iter()
+            .take_while(|c| c.domain() == Domain::Disk)
+            .count();
+        debug_assert!(
+            atlas.charts()[disks..]
+                .iter()
+                .all(|c| c.domain() == Domain::Square),
+            "an atlas lists its disk charts first"
+        );
         Ok(Layout {
             atlas,
-            basis: UniformBasis::new(settings.degree, settings.grid)?,
+            bases: Bases {
+                square: UniformBasis::new(settings.degree, settings.grid)?,
+                disk: UniformBasis::new(settings.degree, settings.disk_grid())?,
+                disks,
+            },
             settings,
         })
     }
 
-    /// A layout from settings [`Layout::new`] has accepted before (their basis is `basis`).
+    /// A layout from settings [`Layout::new`] has accepted before (their bases are `bases`).
     pub(crate) fn from_checked(
         atlas: &'a Atlas,
-        basis: UniformBasis,
+        bases: Bases,
         settings: SplineSettings,
     ) -> Layout<'a> {
         Layout {
             atlas,
-            basis,
+            bases,
             settings,
         }
     }
 
-    pub(crate) fn basis(&self) -> UniformBasis {
-        self.basis
+    pub(crate) fn bases(&self) -> Bases {
+        self.bases
+    }
+
+    /// The B-spline basis of `chart`'s patch.
+    pub fn basis(&self, chart: ChartId) -> &UniformBasis {
+        if chart.index() < self.bases.disks {
+            &self.bases.disk
+        } else {
+            &self.bases.square
+        }
+    }
+
+    /// Control points per side of `chart`'s grid.
+    pub fn grid(&self, chart: ChartId) -> usize {
+        self.basis(chart).count()
+    }
+
+    /// How the control points are numbered (without the bases).
+    pub fn grids(&self) -> ControlGrids {
+        ControlGrids {
+            square: self.bases.square.count(),
+            disk: self.bases.disk.count(),
+            disks: self.bases.disks,
+            charts: self.atlas.charts().len(),
+        }
+    }
+
+    /// The index of `chart`'s first control point; its g² points follow it.
+    pub fn chart_offset(&self, chart: ChartId) -> usize {
+        self.grids().offset(chart)
     }
 
     pub fn atlas(&self) -> &'a Atlas {
@@ -234,11 +388,10 @@ impl<'a> Layout<'a> {
     }
     /// Total number of control points.
     pub fn control_count(&self) -> usize {
-        self.atlas.charts().len() * self.settings.grid * self.settings.grid
+        self.grids().count()
     }
     pub fn control_index(&self, chart: ChartId, i: usize, j: usize) -> usize {
-        let g = self.settings.grid;
-        chart.index() * g * g + j * g + i
+        self.chart_offset(chart) + j * self.grid(chart) + i
     }
 
     /// The unnormalised blend b_c and its derivatives at w in chart c's own coordinates.
@@ -297,8 +450,9 @@ impl<'a> Layout<'a> {
             let (d1, d2) = derivatives(&psi, p.coords);
             let raw = self.raw_blend(chart.domain(), w);
             add(&mut sum, raw.through(d1, d2));
-            let (fu, nu) = self.basis.eval(w.re, 2);
-            let (fv, nv) = self.basis.eval(w.im, 2);
+            let basis = self.basis(rep.chart);
+            let (fu, nu) = basis.eval(w.re, 2);
+            let (fv, nv) = basis.eval(w.im, 2);
             // (value, first, second derivative) of each of the p + 1 basis functions alive here.
             let triples = |n: &[[f64; crate::bspline::MAX_DEGREE + 1]; 4]| {
                 std::array::from_fn::<[f64; 3], { crate::bspline::MAX_DEGREE + 1 }, _>(|k| {
@@ -335,8 +489,9 @@ impl<'a> Layout<'a> {
             let w = rep.coords;
             let raw = self.raw_blend_value(chart.domain(), w);
             sum += raw;
-            let (fu, nu) = self.basis.values(w.re);
-            let (fv, nv) = self.basis.values(w.im);
+            let basis = self.basis(rep.chart);
+            let (fu, nu) = basis.values(w.re);
+            let (fv, nv) = basis.values(w.im);
             for (j, y) in nv[..p1].iter().enumerate() {
                 for (i, x) in nu[..p1].iter().enumerate() {
                     let control = self.control_index(rep.chart, fu + i, fv + j) as u32;
@@ -354,8 +509,9 @@ impl<'a> Layout<'a> {
     /// with its basis value (appended to `out`).
     pub fn patch_weights(&self, p: ChartPoint, out: &mut Vec<(u32, f64)>) {
         let p1 = self.settings.degree + 1;
-        let (fu, nu) = self.basis.eval(p.coords.re, 0);
-        let (fv, nv) = self.basis.eval(p.coords.im, 0);
+        let basis = self.basis(p.chart);
+        let (fu, nu) = basis.eval(p.coords.re, 0);
+        let (fv, nv) = basis.eval(p.coords.im, 0);
         for (j, y) in nv[0][..p1].iter().enumerate() {
             for (i, x) in nu[0][..p1].iter().enumerate() {
                 out.push((self.control_index(p.chart, fu + i, fv + j) as u32, x * y));
@@ -393,8 +549,9 @@ impl<'a> Layout<'a> {
             let chart = &self.atlas.charts()[rep.chart.index()];
             let w = rep.coords;
             let blend = self.raw_blend_value(chart.domain(), w);
-            let (fu, nu) = self.basis.eval(w.re, 0);
-            let (fv, nv) = self.basis.eval(w.im, 0);
+            let basis = self.basis(rep.chart);
+            let (fu, nu) = basis.eval(w.re, 0);
+            let (fv, nv) = basis.eval(w.im, 0);
             let mut patch = Vector3::zeros();
             for (j, y) in nv[0][..p1].iter().enumerate() {
                 for (i, x) in nu[0][..p1].iter().enumerate() {
@@ -447,8 +604,9 @@ impl<'a> Layout<'a> {
             let (d1, d2) = derivatives(&psi, p.coords);
             let raw = self.raw_blend(chart.domain(), w);
             add(&mut denominator, raw.through(d1, d2));
-            let (fu, nu) = self.basis.eval(w.re, 2);
-            let (fv, nv) = self.basis.eval(w.im, 2);
+            let basis = self.basis(rep.chart);
+            let (fu, nu) = basis.eval(w.re, 2);
+            let (fv, nv) = basis.eval(w.im, 2);
             // E_c and its derivatives in its own chart's coordinates: each row of control
             // points summed along u first (value, ∂u, ∂uu), then the rows along v.
             let zero = Vector3::zeros;

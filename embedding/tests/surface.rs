@@ -362,6 +362,8 @@ fn the_surface_is_ck_across_every_kind_of_chart_boundary() {
                 degree,
                 continuity: k,
                 grid: 8,
+                // A finer grid in the disk charts: the surface is C^k wherever grids differ too.
+                disk_grid: Some(13),
             },
         )
         .unwrap();
@@ -459,10 +461,11 @@ proptest! {
         degree in 2usize..=5,
         grid in 8usize..=20,
         continuity in 1usize..=3,
+        disk in prop::option::of(4usize..=28),
         units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..400),
     ) {
         let atlas = atlas(genus);
-        let settings = SplineSettings { degree, grid, continuity };
+        let settings = SplineSettings { degree, grid, continuity, disk_grid: disk.map(|d| d.max(degree + 1)) };
         let layout = Layout::new(atlas, settings).unwrap();
         let mut points: Vec<ChartPoint> = units.iter().map(|&(a, b, c)| chart_point(atlas, a, b, c)).collect();
         // Chart boundaries, corners, the vertex chart's centre; and more rows than one task holds.
@@ -499,10 +502,11 @@ proptest! {
         degree in 1usize..=5,
         grid in 8usize..=48,
         continuity in 1usize..=4,
+        disk in prop::option::of(4usize..=28),
         units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..200),
     ) {
         let atlas = atlas(genus);
-        let settings = SplineSettings { degree, grid, continuity };
+        let settings = SplineSettings { degree, grid, continuity, disk_grid: disk.map(|d| d.max(degree + 1)) };
         let layout = Layout::new(atlas, settings).unwrap();
         let mut points: Vec<ChartPoint> = units.iter().map(|&(a, b, c)| chart_point(atlas, a, b, c)).collect();
         points.extend_from_slice(&atlas.tessellate(2, 2).unwrap().vertices);
@@ -669,6 +673,46 @@ proptest! {
     }
 }
 
+/// A model whose disk charts have their own grid is written as version 3 and read back equal; one
+/// without is still version 1 (what every build reads); a disk grid in an older version is
+/// refused rather than read with the wrong control point layout.
+#[test]
+fn a_disk_grid_round_trips_as_version_3_and_only_there() {
+    for genus in [0, 1, 2, 5] {
+        let atlas = std::sync::Arc::new(Atlas::new(genus).unwrap());
+        let settings = SplineSettings {
+            grid: 6,
+            disk_grid: Some(9),
+            ..SplineSettings::default()
+        };
+        let layout = Layout::new(&atlas, settings).unwrap();
+        let disks = atlas
+            .charts()
+            .iter()
+            .filter(|c| c.domain() == charts::Domain::Disk)
+            .count();
+        assert_eq!(
+            layout.control_count(),
+            disks * 81 + (atlas.charts().len() - disks) * 36
+        );
+        let surface =
+            embedding::Surface::new(atlas.clone(), settings, noisy_controls(&layout, 3)).unwrap();
+        let model = surface.to_model();
+        assert_eq!(model.version, embedding::DISK_GRID_VERSION);
+        assert_eq!(embedding::Surface::from_model(&model).unwrap(), surface);
+        let mut old = model.clone();
+        old.version = 2;
+        assert_eq!(
+            embedding::Surface::from_model(&old),
+            Err(embedding::EmbeddingError::DiskGridVersion {
+                grid: 9,
+                version: 2
+            })
+        );
+    }
+    assert_eq!(noisy_surface(2, 7).to_model().version, 1);
+}
+
 #[test]
 fn surfaces_are_validated_once_when_built() {
     let surface = noisy_surface(2, 7);
@@ -714,12 +758,13 @@ proptest! {
         degree in 2usize..=5,
         grid in 8usize..=20,
         continuity in 1usize..=3,
+        disk in prop::option::of(4usize..=28),
         seed in any::<u64>(),
         offset in prop::array::uniform3(-1e4f64..1e4),
         units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..400),
     ) {
         let atlas = atlas(genus);
-        let settings = SplineSettings { degree, grid, continuity };
+        let settings = SplineSettings { degree, grid, continuity, disk_grid: disk.map(|d| d.max(degree + 1)) };
         let layout = Layout::new(atlas, settings).unwrap();
         let shift = Vector3::from(offset);
         let control: Vec<Point3> = noisy_controls(&layout, seed).into_iter().map(|c| c + shift).collect();
@@ -759,12 +804,13 @@ proptest! {
         degree in 2usize..=5,
         grid in 8usize..=20,
         continuity in 1usize..=3,
+        disk in prop::option::of(4usize..=28),
         seed in any::<u64>(),
         offset in prop::array::uniform3(-1e4f64..1e4),
         units in prop::collection::vec((0usize..1000, 0.0f64..1.0, 0.0f64..1.0), 1..300),
     ) {
         let atlas = atlas(genus);
-        let settings = SplineSettings { degree, grid, continuity };
+        let settings = SplineSettings { degree, grid, continuity, disk_grid: disk.map(|d| d.max(degree + 1)) };
         let layout = Layout::new(atlas, settings).unwrap();
         let shift = Vector3::from(offset);
         let control: Vec<Point3> = noisy_controls(&layout, seed).into_iter().map(|c| c + shift).collect();

@@ -98,7 +98,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         MESH_FIT_GRID
     };
-    let (settings, fit) = args.spline.settings(default_grid);
+    // A user's mesh keeps one grid for every chart unless asked (`new`'s disk grids were measured
+    // on its plates only).
+    let (settings, fit) = args.spline.settings(default_grid, |_| None);
     let progress = FitProgress::new(args.quiet);
     let fitted = mesh_model(
         &valid.positions,

@@ -100,6 +100,12 @@ struct FitArgs {
     /// often coarser than the plates, and a grid finer than the data overfits it]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=64))]
     grid: Option<u64>,
+    /// Control points per side of the disk charts' grids (the inside and vertex charts, which
+    /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
+    /// the grid from genus 3 (96 at 48) and 8/3 of it from genus 16 (128), the grid below genus
+    /// 3; the grid for fit]
+    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=256))]
+    disk_grid: Option<u64>,
     /// Spline degree.
     #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
           value_parser = clap::value_parser!(u64).range(1..=7))]
@@ -116,12 +122,24 @@ struct FitArgs {
 }
 
 impl FitArgs {
-    /// The settings asked for; the grid is `default_grid` where none was given.
-    fn settings(&self, default_grid: usize) -> (SplineSettings, FitSettings) {
+    /// The settings asked for; the grid is `default_grid` where none was given, and the disk
+    /// charts' grid `default_disk_grid` of the grid (`None`: the grid).
+    fn settings(
+        &self,
+        default_grid: usize,
+        default_disk_grid: impl Fn(usize) -> Option<usize>,
+    ) -> (SplineSettings, FitSettings) {
+        let grid = self.grid.map_or(default_grid, |g| g as usize);
+        let disk_grid = self
+            .disk_grid
+            .map(|g| g as usize)
+            .or_else(|| default_disk_grid(grid))
+            .filter(|&d| d != grid);
         let spline = SplineSettings {
             degree: self.degree as usize,
             continuity: self.continuity as usize,
-            grid: self.grid.map_or(default_grid, |g| g as usize),
+            grid,
+            disk_grid,
         };
         let fit = FitSettings {
             smoothness: self

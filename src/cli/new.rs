@@ -85,7 +85,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         quiet,
     } = args;
-    let (settings, fit) = spline.settings(embedding::fit::default_grid(genus));
+    let (settings, fit) = spline.settings(embedding::fit::default_grid(genus), |grid| {
+        embedding::fit::default_disk_grid(genus, grid)
+    });
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;
@@ -520,7 +522,7 @@ impl NewReport {
     pub fn to_text(&self) -> String {
         let verdict = |ok: bool| if ok { "ok" } else { "FAILED" };
         format!(
-            "genus {genus}: degree {degree}, C^{cont} blends, {grid}×{grid} control grid per chart, \
+            "genus {genus}: degree {degree}, C^{cont} blends, {grid}, \
              {controls} control points\n\
              input mesh: {v} vertices, {f} triangles, bounding-box diagonal {diag:.3}\n\
              parameterization: {solve}, {folded} folded triangles ({bij}){distortion}\n\
@@ -536,7 +538,7 @@ impl NewReport {
             genus = self.genus,
             degree = self.settings.degree,
             cont = self.settings.continuity,
-            grid = self.settings.grid,
+            grid = self.settings.grid_text(),
             controls = self.control_points,
             v = self.mesh_vertices,
             f = self.mesh_triangles,

@@ -198,6 +198,7 @@ fn new_model(
                 settings_grid(ui, &mut settings);
             });
             settings.grid = settings.grid.max(settings.degree + 1);
+            settings.disk_grid = settings.disk_grid.map(|g| g.max(settings.degree + 1));
             ui.label("The surface is fitted to a mesh with that many holes (as `ntori new` does).");
             create = ui.button("Create").clicked();
         });

@@ -158,8 +158,10 @@ impl Jobs {
     /// Refits `surface` with other spline settings.
     pub fn refit(&mut self, surface: Surface, settings: SplineSettings) {
         let what = format!(
-            "refitting to degree {}, C^{}, grid {}",
-            settings.degree, settings.continuity, settings.grid
+            "refitting to degree {}, C^{}, {}",
+            settings.degree,
+            settings.continuity,
+            settings.grid_text()
         );
         self.spawn(what, move || {
             let (control, worst) = refit(&surface, settings).map_err(JobError::Refit)?;
@@ -214,7 +216,8 @@ pub fn refit(
     let atlas = surface.atlas();
     let new = Layout::new(atlas, settings)?;
     // About four samples per control point along each side of a chart.
-    let t = (2 * settings.grid.max(surface.settings().grid)).clamp(16, 96) as u32;
+    let finest = |s: SplineSettings| s.grid.max(s.disk_grid());
+    let t = (2 * finest(settings).max(finest(surface.settings()))).clamp(16, 96) as u32;
     let tessellation = atlas.tessellate(t, t)?;
     let stencil = embedding::Stencil::build_parallel(&surface.layout(), &tessellation.vertices);
     let mut targets = vec![Point3::origin(); stencil.rows()];

@@ -267,6 +267,7 @@ impl SidePanel {
             .num_columns(2)
             .show(ui, |ui| settings_grid(ui, d));
         d.grid = d.grid.max(d.degree + 1);
+        d.disk_grid = d.disk_grid.map(|g| g.max(d.degree + 1));
         let changed = *d != state.settings();
         let draft = *d;
         ui.horizontal(|ui| {
@@ -599,11 +600,22 @@ pub fn settings_grid(ui: &mut egui::Ui, s: &mut SplineSettings) {
     ui.add(egui::DragValue::new(&mut s.continuity).range(1..=4))
         .labelled_by(label.id);
     ui.end_row();
-    let label = ui.label("Grid per chart");
+    let label = ui.label("Grid per edge chart");
     ui.add(egui::DragValue::new(&mut s.grid).range(s.degree + 1..=64))
         .labelled_by(label.id);
     ui.end_row();
+    // The inside and vertex charts (the sphere's caps) carry more of the surface, with coarser
+    // cells at their rims: they may take a finer grid.
+    let label = ui.label("Grid per disk chart");
+    let mut disk = s.disk_grid();
+    ui.add(egui::DragValue::new(&mut disk).range(s.degree + 1..=MAX_DISK_GRID))
+        .labelled_by(label.id);
+    s.disk_grid = (disk != s.grid).then_some(disk);
+    ui.end_row();
 }
+
+/// The finest disk-chart grid the settings panels offer (as `ntori new --disk-grid`).
+pub const MAX_DISK_GRID: usize = 192;
 
 /// The five styles as radio buttons; choosing another one is a command.
 fn style_radio(ui: &mut egui::Ui, current: Style, commands: &mut Vec<Command>) {

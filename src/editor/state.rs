@@ -865,8 +865,10 @@ impl EditorState {
         self.replace_control(settings, control.clone())?;
         self.history.push(
             format!(
-                "settings: degree {}, C^{}, grid {}",
-                settings.degree, settings.continuity, settings.grid
+                "settings: degree {}, C^{}, {}",
+                settings.degree,
+                settings.continuity,
+                settings.grid_text()
             ),
             Change::Settings {
                 before,
@@ -896,12 +898,12 @@ impl EditorState {
         Ok(())
     }
 
-    /// The control points of one chart, as a grid × grid net (row j, column i at j·grid + i).
+    /// The control points of one chart, as a g × g net (g its grid; row j, column i at j·g + i).
     pub fn control_net(&self, chart: ChartId) -> &[Point3] {
-        let g = self.settings().grid;
-        let start = chart.index() * g * g;
+        let grids = self.layout().grids();
+        let (start, g) = (grids.offset(chart), grids.grid(chart));
         let control = self.control();
-        &control[start..(start + g * g).min(control.len())]
+        &control[start.min(control.len())..(start + g * g).min(control.len())]
     }
 
     /// Where a viewport pixel's ray meets the surface, as text for the status bar.

@@ -462,7 +462,7 @@ fn control_net(
     chart: charts::ChartId,
     project: &dyn Fn(Point3) -> Option<Pos2>,
 ) {
-    let g = state.settings().grid;
+    let g = state.layout().grid(chart);
     let net = state.control_net(chart);
     let colour = {
         let c = state

@@ -60,11 +60,18 @@ impl GpuReembed {
                 usage: wgpu::BufferUsages::STORAGE,
             })
         };
+        let grids = stencil.grids();
+        // Eight words: the shader's Params, padded to a multiple of 16 bytes for a uniform. Grids
+        // are at most 4096 per side (`UniformBasis`), so the disks hold fewer than 2³² points.
         let params = [
             rows,
             stencil.order() as u32,
-            stencil.grid() as u32,
+            grids.square as u32,
             stride as u32,
+            grids.disk as u32,
+            (grids.disks * grids.disk * grids.disk) as u32,
+            0,
+            0,
         ];
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ntori reembed params"),

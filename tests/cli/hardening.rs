@@ -634,6 +634,12 @@ fn bad_input_fixtures(dir: &Path) -> Vec<(String, std::path::PathBuf)> {
             }),
         ),
         (
+            "DISK_GRID_VERSION1".into(),
+            edit("disk-grid-version1.json", &|v| {
+                v["settings"]["disk_grid"] = 8.into();
+            }),
+        ),
+        (
             "LONG_STRING".into(),
             edit("long.json", &|v| v["genus"] = "y".repeat(1_000_000).into()),
         ),

@@ -623,7 +623,8 @@ impl Reach {
         // the blend alone leaves the patches free to disagree in the overlaps, and they would
         // ripple. A stencil row's entries of chart i are β_i N_c (uniform B-splines sum to 1), so
         // chart i's patch row is those entries over their sum β_i: no second evaluation.
-        let per_chart = (layout.settings().grid * layout.settings().grid) as u32;
+        let grids = layout.grids();
+        let chart_of = |c: u32| grids.locate(c as usize).0;
         let mut row = Vec::new();
         for (k, &r) in reach.samples.iter().enumerate() {
             let (r, area) = (r as usize, areas[r as usize]);
@@ -638,7 +639,7 @@ impl Reach {
                 .rows
                 .push((k as u32, area, first..reach.entries.len() as u32));
             // Per chart (the row is sorted by control point, so by chart).
-            for group in row.chunk_by(|a, b| a.0 / per_chart == b.0 / per_chart) {
+            for group in row.chunk_by(|a, b| chart_of(a.0) == chart_of(b.0)) {
                 let blend: f64 = group.iter().map(|e| e.1).sum();
                 if blend <= 1e-12 {
                     continue;
@@ -724,16 +725,14 @@ impl Reach {
         };
         // Only the rows near the moving control points can touch them: those whose first point
         // lies up to two steps before one of them along each grid direction, each taken once.
-        let g = layout.settings().grid;
+        let grids = layout.grids();
         let mut origins = vec![0u64; layout.control_count().div_ceil(64)];
         for &c in &self.controls {
-            mark_windows_holding(&mut origins, c as usize, g, 3);
+            mark_windows_holding(&mut origins, c as usize, grids, 3);
         }
         let mut entries = Vec::new();
         for o in set_bits(&origins) {
-            let (o, per_chart) = (o as usize, g * g);
-            let chart = charts::ChartId((o / per_chart) as u32);
-            let (j, i) = ((o % per_chart) / g, o % g);
+            let (chart, i, j) = grids.locate(o as usize);
             crate::fit::smoothness_rows_at(layout, chart, i, j, |row| {
                 entries.clear();
                 entries.extend(

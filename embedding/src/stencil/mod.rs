@@ -15,7 +15,7 @@ pub use tensor::{ControlFrame, Followed, NEGLIGIBLE_BLEND, TensorStencil, tangen
 
 use charts::ChartPoint;
 
-use crate::surface::{Layout, Point3, Vector3};
+use crate::surface::{ControlGrids, Layout, Point3, Vector3};
 
 /// Sparse weights, one row per surface point.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -272,20 +272,23 @@ impl Stencil {
 }
 
 /// Sets, in `bits` (a bit per control point), the first control point of every `width` × `width`
-/// window of a chart's `grid` × `grid` control grid that holds control point `c` (control points
-/// are numbered chart by chart, a grid line after another).
-pub(crate) fn mark_windows_holding(bits: &mut [u64], c: usize, grid: usize, width: usize) {
-    for first in windows_holding(c, grid, width) {
+/// window of its chart's control grid that holds control point `c` (control points are numbered
+/// chart by chart, a grid line after another: `grids`).
+pub(crate) fn mark_windows_holding(bits: &mut [u64], c: usize, grids: ControlGrids, width: usize) {
+    for first in windows_holding(c, grids, width) {
         bits[first / 64] |= 1 << (first % 64);
     }
 }
 
-/// The first control points of the `width` × `width` windows of a chart's `grid` × `grid` control
-/// grid that hold control point `c`.
-pub(crate) fn windows_holding(c: usize, grid: usize, width: usize) -> impl Iterator<Item = usize> {
-    let per_chart = grid * grid;
-    let (base, local) = (c - c % per_chart, c % per_chart);
-    let (row, column) = (local / grid, local % grid);
+/// The first control points of the `width` × `width` windows of its chart's control grid that
+/// hold control point `c`.
+pub(crate) fn windows_holding(
+    c: usize,
+    grids: ControlGrids,
+    width: usize,
+) -> impl Iterator<Item = usize> {
+    let (chart, column, row) = grids.locate(c);
+    let (base, grid) = (grids.offset(chart), grids.grid(chart));
     (0..=row.min(width - 1)).flat_map(move |j| {
         (0..=column.min(width - 1)).map(move |i| base + (row - j) * grid + (column - i))
     })
@@ -404,7 +407,7 @@ impl<'a> RowsMut<'a> {
     /// the chain rule through a conformal map taking (f_x, f_y) to (a f_x + b f_y, −b f_x + a f_y).
     fn write_chart(&mut self, layout: &Layout, b: &tensor::Blend, mut at: usize) -> usize {
         let order = layout.settings().degree + 1;
-        let basis = layout.basis();
+        let basis = layout.basis(b.rep.chart);
         let w = b.rep.coords;
         let (fu, nu) = basis.eval(w.re, 1);
         let (fv, nv) = basis.eval(w.im, 1);
@@ -431,7 +434,61 @@ impl<'a> RowsMut<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::{LEAST_PARALLEL_NS, LEAST_ROWS_PER_TASK, rows_per_task};
+    use super::{LEAST_PARALLEL_NS, LEAST_ROWS_PER_TASK, rows_per_task, windows_holding};
+    use crate::surface::ControlGrids;
+    use charts::ChartId;
+
+    /// Control points are numbered chart by chart, each chart's grid its own (the disk charts'
+    /// first): `locate` inverts the numbering, `stride` is the chart's grid, and the windows
+    /// holding a control point are exactly the width × width windows of its chart's grid that
+    /// contain it (checked against every window of every chart).
+    #[test]
+    fn control_grids_number_every_chart_in_turn_and_find_its_windows() {
+        for (square, disk, disks, charts) in [
+            (5, 5, 2, 6),
+            (5, 9, 2, 6),
+            (7, 4, 2, 10),
+            (6, 11, 2, 2),
+            (4, 8, 0, 3),
+        ] {
+            let grids = ControlGrids {
+                square,
+                disk,
+                disks,
+                charts,
+            };
+            let mut next = 0;
+            for chart in (0..charts as u32).map(ChartId) {
+                let g = grids.grid(chart);
+                assert_eq!(g, if chart.index() < disks { disk } else { square });
+                assert_eq!(grids.offset(chart), next);
+                for j in 0..g {
+                    for i in 0..g {
+                        assert_eq!(grids.locate(next), (chart, i, j));
+                        assert_eq!(grids.stride(next), g);
+                        next += 1;
+                    }
+                }
+            }
+            assert_eq!(grids.count(), next);
+            let width = 3;
+            for c in 0..grids.count() {
+                let mut found: Vec<usize> = windows_holding(c, grids, width).collect();
+                found.sort_unstable();
+                let (chart, ci, cj) = grids.locate(c);
+                let (base, g) = (grids.offset(chart), grids.grid(chart));
+                let mut expected = Vec::new();
+                for j in 0..g {
+                    for i in 0..g {
+                        if (i..i + width).contains(&ci) && (j..j + width).contains(&cj) {
+                            expected.push(base + j * g + i);
+                        }
+                    }
+                }
+                assert_eq!(found, expected, "control point {c}");
+            }
+        }
+    }
 
     /// Split work is in tasks of at most `most` rows, as many as a multiple of the threads and
     /// all but the last of one size, which is never much longer; little work is not split.

@@ -29,7 +29,7 @@ use rayon::prelude::*;
 use num_complex::Complex64;
 
 use super::rows_per_task;
-use crate::surface::{Jet, Layout, Point3, Vector3, derivatives};
+use crate::surface::{ControlGrids, Jet, Layout, Point3, Vector3, derivatives};
 
 /// A chart whose normalised blend at a point is below this is left out of the point's row, and the
 /// others' blends are renormalised. The position then moves by at most this fraction of the
@@ -64,8 +64,8 @@ const FOLLOW_NS: usize = 10;
 pub struct TensorStencil {
     /// B-spline order (degree + 1): a chart's block is order × order control points.
     order: usize,
-    /// Control points per side of a chart's grid: the stride between a block's lines.
-    grid: usize,
+    /// How control points are numbered: a block's lines are its chart's grid apart.
+    grids: ControlGrids,
     /// Row r's blocks are `row_starts[r]..row_starts[r + 1]`.
     row_starts: Vec<u32>,
     /// Per block: the index of its first control point (lowest i and j).
@@ -181,7 +181,7 @@ impl TensorStencil {
         let blocks: usize = parts.iter().map(|p| p.firsts.len()).sum();
         let mut s = TensorStencil {
             order: settings.degree + 1,
-            grid: settings.grid,
+            grids: layout.grids(),
             row_starts: Vec::with_capacity(points.len() + 1),
             firsts: Vec::with_capacity(blocks),
             factors: Vec::with_capacity(blocks * 2 * (settings.degree + 1)),
@@ -245,9 +245,10 @@ impl TensorStencil {
         self.order
     }
 
-    /// Control points per side of a chart's grid (the stride between a block's lines).
-    pub fn grid(&self) -> usize {
-        self.grid
+    /// How the control points are numbered: a block starting at control point c has its lines
+    /// [`ControlGrids::stride`]`(c)` apart.
+    pub fn grids(&self) -> ControlGrids {
+        self.grids
     }
 
     /// Row r's blocks are `row_starts()[r]..row_starts()[r + 1]`.
@@ -439,7 +440,7 @@ impl TensorStencil {
         let mut windows = vec![0u64; control.len().div_ceil(64).max(1)];
         for &(c, d) in moved {
             motion[c as usize] = d.norm() as f32;
-            super::mark_windows_holding(&mut windows, c as usize, self.grid, self.order);
+            super::mark_windows_holding(&mut windows, c as usize, self.grids, self.order);
         }
         let index = self
             .rows_by_first
@@ -503,12 +504,13 @@ impl TensorStencil {
         let mut bound = 0.0;
         for k in self.row_starts[r] as usize..self.row_starts[r + 1] as usize {
             let first = self.firsts[k] as usize;
+            let grid = self.grids.stride(first);
             if windows[first / 64] & (1 << (first % 64)) == 0 {
                 continue;
             }
             let (u, v) = self.factors[2 * O * k..2 * O * (k + 1)].split_at(O);
             for (j, &vj) in v.iter().enumerate() {
-                let start = first + j * self.grid;
+                let start = first + j * grid;
                 let line: &[f32; O] = motion[start..start + O].try_into().expect("a block line");
                 let s: f32 = u.iter().zip(line).map(|(&ui, &m)| ui * m).sum();
                 bound += vj * s;
@@ -566,9 +568,10 @@ impl TensorStencil {
                 let (du, rest) = d.split_at(O);
                 let (dv, chain) = rest.split_at(O);
                 let first = self.firsts[k] as usize;
+                let grid = self.grids.stride(first);
                 let (mut a, mut b, mut c) = (Vec4::ZERO, Vec4::ZERO, Vec4::ZERO);
                 for j in 0..O {
-                    let start = first + j * self.grid;
+                    let start = first + j * grid;
                     let line: &[Vec4; O] = frame.points[start..start + O]
                         .try_into()
                         .expect("a block line");
@@ -638,8 +641,9 @@ impl TensorStencil {
                 let u: &[f32; O] = u.try_into().expect("order factors");
                 let v: &[f32; O] = v.try_into().expect("order factors");
                 let first = self.firsts[k] as usize;
+                let grid = self.grids.stride(first);
                 for (j, &vj) in v.iter().enumerate() {
-                    let start = first + j * self.grid;
+                    let start = first + j * grid;
                     let line: &[Vec4; O] = frame.points[start..start + O]
                         .try_into()
                         .expect("a block line");
@@ -691,8 +695,9 @@ mod simd {
                 let u01 = _mm256_set_m128(_mm_set1_ps(f[1]), _mm_set1_ps(f[0]));
                 let u23 = _mm256_set_m128(_mm_set1_ps(f[3]), _mm_set1_ps(f[2]));
                 let first = stencil.firsts[k] as usize;
+                let grid = stencil.grids.stride(first);
                 for (j, &v) in f[4..].iter().enumerate() {
-                    let start = first + j * stencil.grid;
+                    let start = first + j * grid;
                     let line = &frame.points[start..start + 4];
                     let p = line.as_ptr().cast::<f32>();
                     // SAFETY: `line` is 4 Vec4s, 16 contiguous f32; the loads read floats 0–7 and
@@ -744,13 +749,14 @@ mod simd {
                 let (u01, u23) = (pair(f[0], f[1]), pair(f[2], f[3]));
                 let (du01, du23) = (pair(d[0], d[1]), pair(d[2], d[3]));
                 let first = stencil.firsts[k] as usize;
+                let grid = stencil.grids.stride(first);
                 let (mut a, mut b, mut c) = (
                     _mm256_setzero_ps(),
                     _mm256_setzero_ps(),
                     _mm256_setzero_ps(),
                 );
                 for j in 0..4 {
-                    let start = first + j * stencil.grid;
+                    let start = first + j * grid;
                     let line = &frame.points[start..start + 4];
                     let ptr = line.as_ptr().cast::<f32>();
                     // SAFETY: `line` is 4 Vec4s, 16 contiguous f32; the loads read floats 0–7 and
@@ -838,7 +844,7 @@ impl Part {
     /// One chart's block: its first control point, its factors, and with `tangents` theirs.
     fn push_block(&mut self, layout: &Layout, b: &Blend, tangents: bool) {
         let order = layout.settings().degree + 1;
-        let basis = layout.basis();
+        let basis = layout.basis(b.rep.chart);
         let w = b.rep.coords;
         let beta = b.jet.val;
         if tangents {
