@@ -781,10 +781,15 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
     let _gpu = gpu_lock();
     let mut harness = harness();
     let before = harness.state().state().unwrap().surface().clone();
-    // The side panel's grid size, then Apply: a refit in the background.
+    // The side panel's grid sizes (every chart's, then the disk charts' apart), then Apply: a
+    // refit in the background.
     harness
         .get_by_label("Grid per chart")
         .set_value_accesskit(12.0);
+    harness.run();
+    harness
+        .get_by_label("Grid per disk chart")
+        .set_value_accesskit(16.0);
     harness.run();
     harness.get_by_label("Apply").click();
     harness.run_steps(2);
@@ -798,7 +803,9 @@ fn new_settings_refit_the_surface_and_undo_restores_it() {
         "{:?}",
         harness.state().messages()
     );
-    assert_eq!(state.control().len(), 6 * 12 * 12);
+    assert_eq!(state.settings().disk_grid, Some(16));
+    // The genus-2 model's inside and vertex disks at 16, its four edge squares at 12.
+    assert_eq!(state.control().len(), 2 * 16 * 16 + 4 * 12 * 12);
     // The refitted surface stays close to the old one.
     let old = EditorState::new(before.clone(), Meshing::default()).unwrap();
     let worst = old

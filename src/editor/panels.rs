@@ -600,12 +600,12 @@ pub fn settings_grid(ui: &mut egui::Ui, s: &mut SplineSettings) {
     ui.add(egui::DragValue::new(&mut s.continuity).range(1..=4))
         .labelled_by(label.id);
     ui.end_row();
-    let label = ui.label("Grid per edge chart");
+    let label = ui.label("Grid per chart");
     ui.add(egui::DragValue::new(&mut s.grid).range(s.degree + 1..=64))
         .labelled_by(label.id);
     ui.end_row();
     // The inside and vertex charts (the sphere's caps) carry more of the surface, with coarser
-    // cells at their rims: they may take a finer grid.
+    // cells at their rims: they may take a finer grid (it follows the grid until set apart).
     let label = ui.label("Grid per disk chart");
     let mut disk = s.disk_grid();
     ui.add(egui::DragValue::new(&mut disk).range(s.degree + 1..=MAX_DISK_GRID))
