@@ -14,11 +14,37 @@ fn main() {
     let layout = Layout::new(&atlas, model.settings).expect("a layout");
     let control = model.points();
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(model.genus));
-    for cells in [2, 3, 4, 6, 8] {
+    let densities: Vec<usize> = std::env::args()
+        .skip(2)
+        .map(|a| a.parse().expect("cells per knot"))
+        .collect();
+    let densities = if densities.is_empty() {
+        vec![2, 3, 4, 6, 8]
+    } else {
+        densities
+    };
+    for cells in densities {
         let sums = surface_integrals(&layout, &control, cells);
         println!(
-            "{cells:3} cells per knot: ∫K dA {:.6} (expected {expected:.6}), ∫|K| dA {:.3}, area {:.4}",
-            sums.gaussian_curvature, sums.absolute_curvature, sums.area
+            "{cells:3} cells per knot: ∫K dA {:.6} (expected {expected:.6}), ∫|K| dA {:.3}, area {:.4}, largest |κ| {:.3}",
+            sums.gaussian_curvature, sums.absolute_curvature, sums.area, sums.largest_curvature
         );
+        if let Some(at) = sums.largest_curvature_at {
+            let p = layout.position(&control, at);
+            let blends: Vec<String> = layout
+                .blends(at)
+                .iter()
+                .map(|(c, b)| format!("{} {b:.3}", c.0))
+                .collect();
+            println!(
+                "    at chart {} {:.4}: [{:.3}, {:.3}, {:.3}], blends {}",
+                at.chart.0,
+                at.coords,
+                p.x,
+                p.y,
+                p.z,
+                blends.join(", ")
+            );
+        }
     }
 }

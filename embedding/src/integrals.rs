@@ -23,12 +23,19 @@ use num_complex::Complex64;
 
 use crate::surface::{Layout, Point3};
 
-/// ∫ K dA, ∫ |K| dA and the area of a surface.
+/// ∫ K dA, ∫ |K| dA and the area of a surface; and, since every quadrature point has the
+/// surface's second derivatives at hand, the largest |κ| of a principal curvature over them (a
+/// far denser look for a spike than a tessellation's vertices: every chart at several points per
+/// knot interval of its grid).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SurfaceIntegrals {
     pub gaussian_curvature: f64,
     pub absolute_curvature: f64,
     pub area: f64,
+    /// The largest |κ₁|, |κ₂| at the quadrature points (infinite where the normal is undefined),
+    /// and the first point where it is reached.
+    pub largest_curvature: f64,
+    pub largest_curvature_at: Option<ChartPoint>,
 }
 
 impl SurfaceIntegrals {
@@ -111,17 +118,36 @@ pub fn surface_integrals(
                 sums.gaussian_curvature += k * da;
                 sums.absolute_curvature += k.abs() * da;
                 sums.area += da;
+                let (k1, k2) = s.principal_curvatures();
+                let largest = k1.abs().max(k2.abs());
+                let largest = if largest.is_nan() {
+                    f64::INFINITY
+                } else {
+                    largest
+                };
+                if largest > sums.largest_curvature || sums.largest_curvature_at.is_none() {
+                    sums.largest_curvature = largest;
+                    sums.largest_curvature_at = Some(p);
+                }
             }
             sums
         })
         .collect();
-    row_sums
-        .iter()
-        .fold(SurfaceIntegrals::default(), |a, b| SurfaceIntegrals {
+    row_sums.iter().fold(SurfaceIntegrals::default(), |a, b| {
+        let (largest_curvature, largest_curvature_at) =
+            if b.largest_curvature > a.largest_curvature || a.largest_curvature_at.is_none() {
+                (b.largest_curvature, b.largest_curvature_at)
+            } else {
+                (a.largest_curvature, a.largest_curvature_at)
+            };
+        SurfaceIntegrals {
             gaussian_curvature: a.gaussian_curvature + b.gaussian_curvature,
             absolute_curvature: a.absolute_curvature + b.absolute_curvature,
             area: a.area + b.area,
-        })
+            largest_curvature,
+            largest_curvature_at,
+        }
+    })
 }
 
 /// Quadrature points and weights along [−½, ½] in `cells` cells of width `h`.

@@ -110,8 +110,11 @@ fn fit_parameters(genus: u32) -> String {
     let (s, f) = default_settings(genus);
     format!(
         "`embedding::fit::initial_model({genus}, {RESOLUTION}, …)` with `ntori new`'s defaults \
-         (degree {}, C^{} blends, {}×{} control grid per chart, smoothness {})",
-        s.degree, s.continuity, s.grid, s.grid, f.smoothness
+         (degree {}, C^{} blends, {}, smoothness {})",
+        s.degree,
+        s.continuity,
+        s.grid_text(),
+        f.smoothness
     )
 }
 
