@@ -1,6 +1,8 @@
 //! Where a model's largest principal curvature sits and what makes it: the blend weights there, and
 //! each chart's own patch (position, |E_u × E_v| and the angle between E_u and E_v, by differences
 //! in that chart's coordinates). `cargo run --release -p embedding --example spot_report MODEL.json`
+//! (the peak over the Gauss–Bonnet check's quadrature points; NTORI_VERTICES=1: over a t = 32
+//! tessellation's vertices)
 use charts::ChartPoint;
 use embedding::Surface;
 use embedding::quality::{max_principal_curvature, sample_points};
@@ -11,8 +13,23 @@ fn main() {
     let text = std::fs::read_to_string(&path).expect("readable");
     let model: embedding::model::Model = serde_json::from_str(&text).expect("a model");
     let surface = Surface::from_model(&model).expect("a surface");
-    let points = sample_points(&surface, 32).expect("a tessellation");
-    let k = max_principal_curvature(&surface, &points);
+    // The peak over the Gauss–Bonnet quadrature's points (dense), or over a t = 32 tessellation's
+    // vertices with NTORI_VERTICES set.
+    let k = if std::env::var("NTORI_VERTICES").is_ok() {
+        let points = sample_points(&surface, 32).expect("a tessellation");
+        max_principal_curvature(&surface, &points)
+    } else {
+        let layout = surface.layout();
+        let sums = embedding::integrals::surface_integrals(
+            &layout,
+            surface.control_points(),
+            embedding::integrals::cells_per_knot(layout.settings()),
+        );
+        embedding::quality::CurvatureExtreme {
+            max_abs: sums.largest_curvature,
+            at: sums.largest_curvature_at,
+        }
+    };
     let at = k.at.expect("a point");
     let layout = surface.layout();
     let control = surface.control_points();
