@@ -207,15 +207,43 @@ fn impossible_requests_are_errors() {
 }
 
 /// The GPU's re-embedding (a compute shader over the tensor stencil) equals the CPU's f64 stencil to
-/// 1e-6 of the bounding-box diagonal, on the example models of genus 0–3 moved far from the origin,
-/// at tessellations of many 64-row workgroups (the last one partly full); built with tangents, its
-/// first derivatives equal the f64 stencil's to 1e-5 of the largest.
+/// 1e-6 of the bounding-box diagonal, on the example models of genus 0–3 moved far from the origin
+/// and on surfaces whose disk charts have a finer grid than their edge charts (a block's lines are
+/// its own chart's grid apart), at tessellations of many 64-row workgroups (the last one partly
+/// full); built with tangents, its first derivatives equal the f64 stencil's to 1e-5 of the
+/// largest.
 #[test]
 fn gpu_reembedding_equals_the_cpu_to_a_millionth_of_the_diagonal() {
-    use embedding::{Point3, Stencil, TensorStencil, Vector3};
+    use embedding::{Point3, SplineSettings, Stencil, Surface, TensorStencil, Vector3};
     let (device, queue, _) = ntori::render::open_device(None).expect("a graphics adapter");
-    for genus in 0..=3 {
-        let model = crate::common::small_model(genus);
+    let with_disk_grid = |genus: u32, disk: usize| {
+        let atlas = std::sync::Arc::new(charts::Atlas::new(genus).unwrap());
+        let settings = SplineSettings {
+            grid: 8,
+            disk_grid: Some(disk),
+            ..SplineSettings::default()
+        };
+        let count = embedding::Layout::new(&atlas, settings)
+            .unwrap()
+            .control_count();
+        // Smooth enough to have normals, different at every control point.
+        let control = (0..count)
+            .map(|i| {
+                let t = i as f64;
+                Point3::new((0.37 * t).sin(), (0.23 * t).cos(), 1e-3 * t)
+            })
+            .collect();
+        Surface::new(atlas, settings, control).unwrap()
+    };
+    let models = (0..=3)
+        .map(|genus| crate::common::small_model(genus).clone())
+        .chain([
+            with_disk_grid(2, 13),
+            with_disk_grid(3, 11),
+            with_disk_grid(0, 9),
+        ]);
+    for model in models {
+        let genus = model.genus();
         let shift = Vector3::new(250.0, -1e3, 40.0);
         let control: Vec<Point3> = model.control_points().iter().map(|c| c + shift).collect();
         let layout = model.layout();
