@@ -68,14 +68,6 @@ impl SplineSettings {
             _ => format!("{g}×{g} control grid per chart"),
         }
     }
-
-    /// Control points per side of a chart's grid with this domain.
-    pub fn grid_for(&self, domain: Domain) -> usize {
-        match domain {
-            Domain::Disk => self.disk_grid(),
-            Domain::Square => self.grid,
-        }
-    }
 }
 
 impl Default for SplineSettings {
@@ -217,9 +209,10 @@ impl SurfaceJet {
 }
 
 /// How control points are laid out over an atlas: one g × g patch per chart (g the chart's grid:
-/// [`SplineSettings::grid_for`] its domain), chart-major, then row-major (index = the chart's
-/// offset + j·g + i for basis i in u, j in v). The disk charts come first in every atlas, so a
-/// chart's offset is a sum of two counts.
+/// [`SplineSettings::disk_grid`] for a disk chart, `grid` for a square), chart-major, then
+/// row-major (index = the chart's offset + j·g + i for basis i in u, j in v). The disk charts
+/// come first in every atlas (tested for every genus), so a chart's offset is a sum of two
+/// counts.
 #[derive(Clone, Debug)]
 pub struct Layout<'a> {
     atlas: &'a Atlas,

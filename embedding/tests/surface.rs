@@ -673,6 +673,28 @@ proptest! {
     }
 }
 
+/// The layout numbers control points chart by chart with the disk charts' grid for a prefix of
+/// the atlas's charts: that prefix must be exactly its disk charts, at every genus.
+#[test]
+fn every_atlas_lists_its_disk_charts_first() {
+    for genus in 0..=charts::MAX_GENUS {
+        let atlas = Atlas::new(genus).unwrap();
+        let kinds: Vec<charts::Domain> = atlas.charts().iter().map(|c| c.domain()).collect();
+        let disks = kinds
+            .iter()
+            .take_while(|&&d| d == charts::Domain::Disk)
+            .count();
+        assert!(
+            kinds[disks..].iter().all(|&d| d == charts::Domain::Square),
+            "genus {genus}: {kinds:?}"
+        );
+        assert_eq!(
+            disks, 2,
+            "genus {genus}: the caps, or the inside and vertex charts"
+        );
+    }
+}
+
 /// A model whose disk charts have their own grid is written as version 3 and read back equal; one
 /// without is still version 1 (what every build reads); a disk grid in an older version is
 /// refused rather than read with the wrong control point layout.
