@@ -151,13 +151,16 @@ fn conflicting_constraints_compromise_instead_of_failing() {
 fn refreshing_after_an_edit_equals_full_re_evaluation() {
     // Grid 8: each control point reaches most of its chart, so the refresh streams all rows; grid 24:
     // it gathers just the rows the moved control points touch. Both must equal a full re-evaluation.
+    // And grid 12 with the disk charts at 20: the column index and the refresh follow each
+    // chart's own numbering.
     let atlas = Atlas::new(2).unwrap();
     let t = atlas.tessellate(8, 6).unwrap();
-    for grid in [8, 24] {
+    for (grid, disk_grid) in [(8, None), (24, None), (12, Some(20))] {
         let layout = Layout::new(
             &atlas,
             SplineSettings {
                 grid,
+                disk_grid,
                 ..SplineSettings::default()
             },
         )
@@ -204,20 +207,26 @@ fn refreshing_after_an_edit_equals_full_re_evaluation() {
 /// genus-2 model, the spline it makes follows the smooth falloff of the model-space distance (the
 /// half-height at 0.454 R within ±15%, at most 6% of Δ beyond 1.1 R, the full displacement at the
 /// centre) at radii of 12%, 20% and 30% of the model's size (at grid 32; at grid 16 only from 20%
-/// outside the edge charts). The footprint is measured on a tessellation other than the brush's
-/// samples.
+/// outside the edge charts); so it does where the disk charts have a finer grid (48) than the edge
+/// charts. The footprint is measured on a tessellation other than the brush's samples.
 #[test]
 fn a_grab_brush_has_the_same_footprint_in_every_kind_of_chart() {
+    for disk_grid in [None, Some(48)] {
+        let settings = SplineSettings {
+            disk_grid,
+            ..SplineSettings::default()
+        };
+        grab_footprints(settings);
+    }
+}
+
+fn grab_footprints(settings: SplineSettings) {
     use charts::ChartKind;
     use embedding::brush::{Falloff, grab_shares};
-    let model = embedding::fit::initial_model(
-        2,
-        32,
-        SplineSettings::default(),
-        embedding::fit::FitSettings::default(),
-    )
-    .unwrap()
-    .surface;
+    let model =
+        embedding::fit::initial_model(2, 32, settings, embedding::fit::FitSettings::default())
+            .unwrap()
+            .surface;
     let layout = model.layout();
     let atlas = model.atlas();
     let points = atlas.tessellate(32, 32).unwrap();
