@@ -1,7 +1,7 @@
 //! The fits, end to end, and the loops of a user's mesh:
 //!
 //! - `initial_fit`: `ntori new`'s pipeline (mesh, cut, Floater, relaxation, least squares) for
-//!   genus 2, 5 and 10 at the default resolution, grid and smoothness. The map dominates: its
+//!   genus 2, 5 and 10 at `ntori new`'s resolution, grid and smoothness (genus 5: resolution 40). The map dominates: its
 //!   sweeps and Newton steps are reported by `ntori new`.
 //! - `mesh_fit`: `ntori fit`'s pipeline (greedy loops from several base vertices, the canonical
 //!   words, the map, least squares) on a genus-4 plate mesh of about 10 000 vertices (issue 14's
@@ -12,7 +12,7 @@
 //! In test mode (`cargo test --benches`) each runs once, on meshes a quarter as fine.
 
 use criterion::{BenchmarkId, Criterion};
-use embedding::fit::{FitSettings, default_settings, initial_model};
+use embedding::fit::{FitSettings, default_resolution, default_settings, initial_model};
 use embedding::holed::HoledMesh;
 use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
 use embedding::{Point3, SplineSettings};
@@ -34,7 +34,8 @@ fn initial_fit(c: &mut Criterion) {
     for genus in [2u32, 5, 10] {
         group.bench_with_input(BenchmarkId::from_parameter(genus), &genus, |b, &g| {
             let (spline, settings) = default_settings(g);
-            b.iter(|| initial_model(g, 32, spline, settings).unwrap())
+            let resolution = default_resolution(g).unwrap();
+            b.iter(|| initial_model(g, resolution, spline, settings).unwrap())
         });
     }
     group.finish();

@@ -27,8 +27,8 @@ fn main() {
     );
     for genus in genera {
         let start = Instant::now();
-        // NTORI_GRID, NTORI_DISK_GRID, NTORI_PATCH_WEIGHT and NTORI_SMOOTHNESS override `ntori
-        // new`'s defaults, for tuning.
+        // NTORI_GRID, NTORI_DISK_GRID, NTORI_PATCH_WEIGHT, NTORI_SMOOTHNESS and NTORI_RESOLUTION
+        // override `ntori new`'s defaults, for tuning.
         let defaults = FitSettings::default();
         let setting = |name: &str, default: f64| {
             std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
@@ -49,7 +49,10 @@ fn main() {
                 as usize,
             ..defaults
         };
-        let resolution = setting("NTORI_RESOLUTION", 32.0) as usize;
+        let resolution = setting(
+            "NTORI_RESOLUTION",
+            embedding::fit::default_resolution(genus).expect("a resolution") as f64,
+        ) as usize;
         let fit = initial_model(genus, resolution, spline, settings).expect("the fit");
         let seconds = start.elapsed().as_secs_f64();
         let s = &fit.surface;
@@ -77,7 +80,7 @@ fn main() {
 
 /// On the plate's flat faces (input vertices at height ±T, away from the rims' bands) the intended
 /// normal is ±z and the mean curvature 0: the 90th percentile of the surface normal's angle from ±z,
-/// and of |H|·T (median, 90%), over those vertices; with NTORI_CENTROIDS set, over the centres
+/// and of |H|·T (median, 90%), over those vertices weighted by their areas; with NTORI_CENTROIDS set, over the centres
 /// of the flat faces' triangles instead, between the points the fit sees. `None` for the sphere and
 /// the torus.
 fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)> {
@@ -86,7 +89,8 @@ fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)
         return None;
     }
     let is_flat = |i: usize| (fit.mesh.positions[i].z.abs() - THICKNESS).abs() < 1e-12;
-    let points: Vec<_> = if std::env::var("NTORI_CENTROIDS").is_ok() {
+    let areas = embedding::fit::vertex_areas(&fit.mesh.positions, &fit.mesh.triangles);
+    let (points, weights): (Vec<_>, Vec<f64>) = if std::env::var("NTORI_CENTROIDS").is_ok() {
         let disk = fit.parameterization.disk.as_ref()?;
         disk.triangles
             .iter()
@@ -100,17 +104,23 @@ fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)
                     .map(|&c| fit.parameterization.copies[c as usize])
                     .sum::<num_complex::Complex64>()
                     / 3.0;
-                fit.surface
+                let area: f64 = t
+                    .iter()
+                    .map(|&c| areas[disk.original[c as usize] as usize])
+                    .sum();
+                let point = fit
+                    .surface
                     .atlas()
                     .locate_model(charts::ModelPoint(z))
-                    .representations()[0]
+                    .representations()[0];
+                (point, area)
             })
-            .collect()
+            .unzip()
     } else {
         (0..fit.mesh.positions.len())
             .filter(|&i| is_flat(i))
-            .map(|i| fit.parameterization.points[i])
-            .collect()
+            .map(|i| (fit.parameterization.points[i], areas[i]))
+            .unzip()
     };
     let mut angles = vec![180.0; points.len()];
     let mut curvatures = vec![f64::INFINITY; points.len()];
@@ -131,9 +141,20 @@ fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)
             }
         },
     );
+    // Weighted by the input's vertex areas, so that a mesh denser near the rims does not count
+    // the flat faces' rim-side edges more than their middles.
     let quantile = |v: &mut Vec<f64>, q: f64| {
-        v.sort_by(f64::total_cmp);
-        v[((v.len() - 1) as f64 * q) as usize]
+        let mut order: Vec<usize> = (0..v.len()).collect();
+        order.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
+        let total: f64 = weights.iter().sum();
+        let mut seen = 0.0;
+        for &i in &order {
+            seen += weights[i];
+            if seen >= q * total {
+                return v[i];
+            }
+        }
+        v[*order.last().expect("flat-face points")]
     };
     Some((
         quantile(&mut angles, 0.9),

@@ -6,14 +6,15 @@
 
 use charts::{ChartPoint, ModelPoint};
 use embedding::edit::{Constraint, solve};
-use embedding::fit::{InitialFit, default_settings, initial_model};
+use embedding::fit::{InitialFit, default_resolution, default_settings, initial_model};
 use embedding::{Point3, Surface, Vector3, bounding_box};
 
 use super::geometry::side_points;
 use super::{Figure, FiguresError, GENUS, palette};
 use crate::render::{CurvatureKind, Curve, Offscreen, RenderError, RenderOptions, Style, View};
 
-/// Input mesh resolution (points around each hole) of every fit.
+/// Input mesh resolution (points around each hole) of the input-mesh figure; the fits take
+/// `ntori new`'s ([`embedding::fit::default_resolution`]).
 pub const RESOLUTION: usize = 32;
 /// Size of the main pictures, and of the gallery's.
 const MAIN: (u32, u32) = (1200, 900);
@@ -44,13 +45,13 @@ impl Studio {
         if let Some(k) = self.fits.iter().position(|(g, _)| *g == genus) {
             return Ok(&self.fits[k].1);
         }
+        let fail = |source| FiguresError::Embedding {
+            figure: figure.to_owned(),
+            source,
+        };
         let (spline, settings) = default_settings(genus);
-        let fit = initial_model(genus, RESOLUTION, spline, settings).map_err(|source| {
-            FiguresError::Embedding {
-                figure: figure.to_owned(),
-                source,
-            }
-        })?;
+        let resolution = default_resolution(genus).map_err(fail)?;
+        let fit = initial_model(genus, resolution, spline, settings).map_err(fail)?;
         self.fits.push((genus, fit));
         Ok(&self.fits.last().expect("just pushed").1)
     }
@@ -108,8 +109,9 @@ fn describe(o: &RenderOptions) -> String {
 
 fn fit_parameters(genus: u32) -> String {
     let (s, f) = default_settings(genus);
+    let resolution = default_resolution(genus).unwrap_or(RESOLUTION);
     format!(
-        "`embedding::fit::initial_model({genus}, {RESOLUTION}, …)` with `ntori new`'s defaults \
+        "`embedding::fit::initial_model({genus}, {resolution}, …)` with `ntori new`'s defaults \
          (degree {}, C^{} blends, {}, smoothness {})",
         s.degree,
         s.continuity,

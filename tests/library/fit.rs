@@ -445,15 +445,21 @@ fn the_default_grid_is_32_up_to_genus_2_and_finer_above_with_more_smoothing() {
     }
 }
 
-/// Without a chosen resolution, high genus gets nearly the finest mesh within the default budget,
-/// and genus 64 the coarsest, which the fit takes: never a refusal.
+/// Without a chosen resolution, genus 3 to 9 get the finer mesh, high genus nearly the finest
+/// mesh within the default budget, and genus 64 the coarsest, which the fit takes: never a refusal.
 #[test]
 fn the_default_resolution_keeps_high_genus_within_the_fit() {
     use embedding::fit::{
-        DEFAULT_FIT_TRIANGLES, DEFAULT_RESOLUTION, MAX_FIT_TRIANGLES, default_resolution,
+        DEFAULT_FIT_TRIANGLES, DEFAULT_RESOLUTION, FINE_RESOLUTION, MAX_FIT_TRIANGLES,
+        default_resolution,
     };
-    for genus in [0, 2, 8, 16] {
+    for genus in [0, 1, 2, 10, 16] {
         assert_eq!(default_resolution(genus).unwrap(), DEFAULT_RESOLUTION);
+    }
+    for genus in 3..=9 {
+        assert_eq!(default_resolution(genus).unwrap(), FINE_RESOLUTION);
+        let triangles = HoledMesh::new(genus, FINE_RESOLUTION).unwrap().triangles.len();
+        assert!(triangles <= DEFAULT_FIT_TRIANGLES, "genus {genus}: {triangles}");
     }
     for genus in [24, 32] {
         let resolution = default_resolution(genus).unwrap();
