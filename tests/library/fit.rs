@@ -458,8 +458,14 @@ fn the_default_resolution_keeps_high_genus_within_the_fit() {
     }
     for genus in 3..=9 {
         assert_eq!(default_resolution(genus).unwrap(), FINE_RESOLUTION);
-        let triangles = HoledMesh::new(genus, FINE_RESOLUTION).unwrap().triangles.len();
-        assert!(triangles <= DEFAULT_FIT_TRIANGLES, "genus {genus}: {triangles}");
+        let triangles = HoledMesh::new(genus, FINE_RESOLUTION)
+            .unwrap()
+            .triangles
+            .len();
+        assert!(
+            triangles <= DEFAULT_FIT_TRIANGLES,
+            "genus {genus}: {triangles}"
+        );
     }
     for genus in [24, 32] {
         let resolution = default_resolution(genus).unwrap();
