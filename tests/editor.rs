@@ -1012,8 +1012,8 @@ fn an_imported_mesh_becomes_an_untitled_model() {
     assert_eq!(state.path(), None, "{messages}");
     assert!(!state.is_modified());
     assert_eq!(
-        state.settings().grid,
-        embedding::mesh_fit::MESH_FIT_GRID,
+        state.settings(),
+        embedding::mesh_fit::default_settings(0).0,
         "{messages}"
     );
     assert!(

@@ -12,10 +12,10 @@
 //! In test mode (`cargo test --benches`) each runs once, on meshes a quarter as fine.
 
 use criterion::{BenchmarkId, Criterion};
-use embedding::fit::{FitSettings, default_resolution, default_settings, initial_model};
+use embedding::Point3;
+use embedding::fit::{default_resolution, default_settings, initial_model};
 use embedding::holed::HoledMesh;
-use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
-use embedding::{Point3, SplineSettings};
+use embedding::mesh_fit::{self, mesh_model};
 use mesh::HalfEdgeMesh;
 use mesh::schema;
 
@@ -44,10 +44,7 @@ fn initial_fit(c: &mut Criterion) {
 /// The genus-4 plate at `resolution` (38: 10 250 vertices), fitted as a user's mesh.
 fn whole_mesh_fit(c: &mut Criterion, resolution: usize) {
     let mesh = HoledMesh::new(4, resolution).unwrap();
-    let settings = SplineSettings {
-        grid: MESH_FIT_GRID,
-        ..SplineSettings::default()
-    };
+    let (settings, fit_settings) = mesh_fit::default_settings(4);
     let mut group = c.benchmark_group("mesh_fit");
     group.sample_size(10);
     let id = format!("genus4_{}v", mesh.positions.len());
@@ -57,7 +54,7 @@ fn whole_mesh_fit(c: &mut Criterion, resolution: usize) {
                 &mesh.positions,
                 &mesh.triangles,
                 settings,
-                FitSettings::default(),
+                fit_settings,
                 &|_| {},
             )
             .unwrap();

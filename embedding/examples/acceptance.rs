@@ -5,7 +5,8 @@
 //! own at the 95th percentile, Gauss–Bonnet, the loops' canonical words, and the time.
 //!
 //! `cargo run --release -p embedding --example acceptance [SCALE] [--large]`: SCALE (default 1)
-//! multiplies each mesh's resolution; `--large` adds the 200 000-triangle plate (minutes).
+//! multiplies each mesh's resolution; `--large` adds the 200 000-triangle plate (minutes). GRID,
+//! DISK_GRID, SMOOTHNESS and ROUNDS override `ntori fit`'s settings.
 #[path = "../tests/shapes/mod.rs"]
 mod shapes;
 
@@ -14,7 +15,7 @@ use std::time::Instant;
 use embedding::fit::FitSettings;
 use embedding::holed::HoledMesh;
 use embedding::integrals::{cells_per_knot, surface_integrals};
-use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
+use embedding::mesh_fit::{self, mesh_model};
 use embedding::quality;
 use embedding::{Point3, SplineSettings};
 
@@ -47,22 +48,25 @@ fn main() {
 }
 
 fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
-    let grid = std::env::var("GRID")
-        .ok()
-        .and_then(|g| g.parse().ok())
-        .unwrap_or(MESH_FIT_GRID);
+    let env = |name: &str| std::env::var(name).ok().and_then(|g| g.parse::<f64>().ok());
+    // χ = V − E + F with E = 3F/2 on a closed triangle mesh.
+    let euler = positions.len() as i64 - triangles.len() as i64 / 2;
+    let genus = u32::try_from((2 - euler) / 2).expect("a closed orientable mesh");
+    let (defaults, fit_defaults) = mesh_fit::default_settings(genus);
+    let grid = env("GRID").map_or(defaults.grid, |g| g as usize);
     let settings = SplineSettings {
         grid,
-        ..SplineSettings::default()
+        disk_grid: env("DISK_GRID").map_or(mesh_fit::mesh_fit_disk_grid(genus, grid), |g| {
+            Some(g as usize)
+        }),
+        ..defaults
     };
     let start = Instant::now();
-    let rounds = std::env::var("ROUNDS")
-        .ok()
-        .and_then(|g| g.parse().ok())
-        .unwrap_or(1);
+    let rounds = env("ROUNDS").map_or(fit_defaults.stretch_rounds, |r| r as usize);
     let fit_settings = FitSettings {
         stretch_rounds: rounds,
-        ..FitSettings::default()
+        smoothness: env("SMOOTHNESS").unwrap_or(embedding::fit::default_smoothness(grid)),
+        ..fit_defaults
     };
     let fit = match mesh_model(positions, triangles, settings, fit_settings, &|_| {}) {
         Ok(fit) => fit,

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use embedding::fit::FitStage;
-use embedding::mesh_fit::{MESH_FIT_GRID, MeshFit, mesh_model};
+use embedding::mesh_fit::{MeshFit, mesh_fit_disk_grid, mesh_fit_grid, mesh_model};
 use ntori::io::import::{self, ValidMesh, cage};
 use serde::Serialize;
 
@@ -96,11 +96,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let default_grid = if cage.is_some() {
         embedding::SplineSettings::default().grid
     } else {
-        MESH_FIT_GRID
+        mesh_fit_grid(valid.genus)
     };
-    // A user's mesh keeps one grid for every chart unless asked (`new`'s disk grids were measured
-    // on its plates only).
-    let (settings, fit) = args.spline.settings(default_grid, |_| None);
+    // A user's mesh gets finer disk charts, as `new`'s plates do (`mesh_fit::default_settings`
+    // says what was measured); a cage keeps one grid, as measured on the slab.
+    let (settings, fit) = if cage.is_some() {
+        args.spline.settings(default_grid, |_| None)
+    } else {
+        args.spline
+            .settings(default_grid, |grid| mesh_fit_disk_grid(valid.genus, grid))
+    };
     let progress = FitProgress::new(args.quiet);
     let fitted = mesh_model(
         &valid.positions,

@@ -96,14 +96,13 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct FitArgs {
     /// Control points per side of each chart's grid [default: for new 32 up to genus 2 and 48 from
-    /// genus 3 (a coarser grid ripples there); 32 for fit --cage; 20 for fit: a user's mesh is
-    /// often coarser than the plates, and a grid finer than the data overfits it]
+    /// genus 3 (a coarser grid ripples there); 40 for fit; 32 for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=64))]
     grid: Option<u64>,
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
     /// the grid from genus 3 (96 at 48) and 8/3 of it from genus 16 (128), the grid below genus
-    /// 3; the grid for fit]
+    /// 3; twice the grid for fit (80 at 40); the grid for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=256))]
     disk_grid: Option<u64>,
     /// Spline degree.

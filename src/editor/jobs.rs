@@ -7,7 +7,7 @@ use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
 use embedding::fit::{FitSettings, default_resolution, initial_model, vertex_areas};
-use embedding::mesh_fit::{MESH_FIT_GRID, mesh_model};
+use embedding::mesh_fit::{self, mesh_model};
 use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
 use super::state::EditorError;
@@ -130,15 +130,13 @@ impl Jobs {
             let valid = import::validate(read, false)
                 .and_then(|valid| import::check_fittable(&valid).map(|()| valid))
                 .map_err(|e| JobError::Import(format!("{}: {e}", path.display())))?;
-            let settings = SplineSettings {
-                grid: MESH_FIT_GRID,
-                ..SplineSettings::default()
-            };
+            // `ntori fit`'s settings.
+            let (settings, fit_settings) = mesh_fit::default_settings(valid.genus);
             let fit = mesh_model(
                 &valid.positions,
                 &valid.triangles,
                 settings,
-                FitSettings::default(),
+                fit_settings,
                 &|_| {},
             )
             .map_err(|source| JobError::ImportFit {
