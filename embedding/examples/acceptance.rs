@@ -6,7 +6,8 @@
 //!
 //! `cargo run --release -p embedding --example acceptance [SCALE] [--large]`: SCALE (default 1)
 //! multiplies each mesh's resolution; `--large` adds the 200 000-triangle plate (minutes). GRID,
-//! DISK_GRID, SMOOTHNESS and ROUNDS override `ntori fit`'s settings.
+//! DISK_GRID, SMOOTHNESS and ROUNDS override `ntori fit`'s settings; DUMP=DIR writes each mesh
+//! there as OBJ.
 #[path = "../tests/shapes/mod.rs"]
 mod shapes;
 
@@ -43,8 +44,28 @@ fn main() {
         cases.push(("genus-4 plate, large", (plate.positions, plate.triangles)));
     }
     for (name, (positions, triangles)) in &cases {
+        if let Ok(dir) = std::env::var("DUMP") {
+            dump(
+                &std::path::Path::new(&dir).join(format!("{}.obj", name.replace([' ', ','], "-"))),
+                positions,
+                triangles,
+            );
+        }
         report(name, positions, triangles);
     }
+}
+
+/// Writes a mesh as OBJ (DUMP=DIR), to fit or look at with `ntori`.
+fn dump(path: &std::path::Path, positions: &[Point3], triangles: &[[u32; 3]]) {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    for p in positions {
+        writeln!(text, "v {} {} {}", p.x, p.y, p.z).expect("a string");
+    }
+    for t in triangles {
+        writeln!(text, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).expect("a string");
+    }
+    std::fs::write(path, text).expect("a writable DUMP directory");
 }
 
 fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
