@@ -93,8 +93,9 @@ pub fn mesh_fit_disk_grid(genus: u32, grid: usize) -> Option<usize> {
 /// 3.1e-4 at 20); at 48/96 it read 0.34% and 3.17°, at 32/64 (λ 2e-3) 0.41% and 4.20°, at 48
 /// without the finer disk charts 0.61% and 4.81°. The tube (genus 1, flat charts) takes one grid:
 /// with disk charts of 80 its normals read 5.47° at the 95th percentile (λ up to 1e-2 did not
-/// move that), at 56 5.91°. The exception is the dumbbell's curvature (within its 4× check; its caps read 3.44×, 4.41×, 3.96× and 3.29× at 32, 40, 56 and 80: the
-/// peak against its coarse mesh's own estimate is erratic). The fit stage takes longer (the
+/// move that), at 56 5.91°. The exception is the dumbbell's curvature (within its 4× check; its
+/// caps read 3.44×, 4.41×, 3.96× and 3.29× at 32, 40, 56 and 80: the peak against its coarse
+/// mesh's own estimate is erratic). The fit stage takes longer (the
 /// genus-4 plate: 0.23 s → 1.1 s, the whole `ntori fit` with its checks 5.5 s → 8.4 s).
 pub fn default_settings(genus: u32) -> (SplineSettings, FitSettings) {
     let grid = mesh_fit_grid(genus);

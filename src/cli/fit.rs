@@ -90,21 +90,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     import::check_fittable(&valid)
         .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
-    // A cage's limit mesh is as dense as `new`'s plates, so it takes `new`'s grid: the genus-2 slab
-    // cage at 20 / 32 fits with patches 0.84% / 0.42% apart, normals 4.5° / 1.6° off its limit
-    // normals at the 90th percentile.
-    let default_grid = if cage.is_some() {
-        embedding::SplineSettings::default().grid
-    } else {
-        mesh_fit_grid(valid.genus)
-    };
-    // A user's mesh gets finer disk charts, as `new`'s plates do (`mesh_fit::default_settings`
-    // says what was measured); a cage keeps one grid, as measured on the slab.
+    // A cage's limit mesh is as dense as `new`'s plates, so it takes `new`'s grid, one for every
+    // chart: the genus-2 slab cage at 20 / 32 fits with patches 0.84% / 0.42% apart, normals
+    // 4.5° / 1.6° off its limit normals at the 90th percentile. A user's mesh gets finer disk
+    // charts, as `new`'s plates do (`mesh_fit::default_settings` says what was measured).
     let (settings, fit) = if cage.is_some() {
-        args.spline.settings(default_grid, |_| None)
-    } else {
         args.spline
-            .settings(default_grid, |grid| mesh_fit_disk_grid(valid.genus, grid))
+            .settings(embedding::SplineSettings::default().grid, |_| None)
+    } else {
+        args.spline.settings(mesh_fit_grid(valid.genus), |grid| {
+            mesh_fit_disk_grid(valid.genus, grid)
+        })
     };
     let progress = FitProgress::new(args.quiet);
     let fitted = mesh_model(

@@ -29,7 +29,8 @@ pub const GALLERY_MEAN_CURVATURE_GENERA: [u32; 4] = [3, 5, 10, 16];
 /// The renderer and the models made so far.
 pub struct Studio {
     offscreen: Offscreen,
-    fits: Vec<(u32, InitialFit)>,
+    /// Per genus: the input mesh's resolution and the fit.
+    fits: Vec<(u32, usize, InitialFit)>,
 }
 
 impl Studio {
@@ -42,8 +43,8 @@ impl Studio {
 
     /// The initial model of `genus` (made on first use).
     fn fit(&mut self, genus: u32, figure: &str) -> Result<&InitialFit, FiguresError> {
-        if let Some(k) = self.fits.iter().position(|(g, _)| *g == genus) {
-            return Ok(&self.fits[k].1);
+        if let Some(k) = self.fits.iter().position(|(g, _, _)| *g == genus) {
+            return Ok(&self.fits[k].2);
         }
         let fail = |source| FiguresError::Embedding {
             figure: figure.to_owned(),
@@ -52,8 +53,18 @@ impl Studio {
         let (spline, settings) = default_settings(genus);
         let resolution = default_resolution(genus).map_err(fail)?;
         let fit = initial_model(genus, resolution, spline, settings).map_err(fail)?;
-        self.fits.push((genus, fit));
-        Ok(&self.fits.last().expect("just pushed").1)
+        self.fits.push((genus, resolution, fit));
+        Ok(&self.fits.last().expect("just pushed").2)
+    }
+
+    /// How the model of `genus` was fitted, for a caption: the resolution its fit used (without
+    /// meshing the plate again to find it), or `ntori new`'s if it is not fitted yet.
+    fn fit_parameters(&self, genus: u32) -> String {
+        let resolution = self.fits.iter().find(|(g, _, _)| *g == genus).map_or_else(
+            || default_resolution(genus).unwrap_or(RESOLUTION),
+            |(_, r, _)| *r,
+        );
+        fit_parameters(genus, resolution)
     }
 
     fn render(
@@ -107,9 +118,8 @@ fn describe(o: &RenderOptions) -> String {
     )
 }
 
-fn fit_parameters(genus: u32) -> String {
+fn fit_parameters(genus: u32, resolution: usize) -> String {
     let (s, f) = default_settings(genus);
-    let resolution = default_resolution(genus).unwrap_or(RESOLUTION);
     format!(
         "`embedding::fit::initial_model({genus}, {resolution}, …)` with `ntori new`'s defaults \
          (degree {}, C^{} blends, {}, smoothness {})",
@@ -345,7 +355,7 @@ pub fn jobs() -> Vec<Job3d> {
                  through the surface's one vertex. Which of a_k and b_k runs around hole k and which \
                  through it is the fit's choice; the paper notes that an embedding may swap them."
                     .into(),
-                format!("{}; {}; 400 samples per loop", fit_parameters(GENUS), describe(&o)),
+                format!("{}; {}; 400 samples per loop", studio.fit_parameters(GENUS), describe(&o)),
                 bytes,
             ))
         }),
@@ -389,7 +399,7 @@ pub fn jobs() -> Vec<Job3d> {
                      {:.3}% of the mesh's diagonal).",
                     100.0 * rms / diag
                 ),
-                format!("{}; {}", fit_parameters(GENUS), describe(&o)),
+                format!("{}; {}", studio.fit_parameters(GENUS), describe(&o)),
                 bytes,
             ))
         }),
@@ -416,7 +426,7 @@ pub fn jobs() -> Vec<Job3d> {
                          edit, the smallest change of the control points that moves the chosen \
                          surface points to their targets and keeps the pinned ones: {what}."
                     ),
-                    format!("{}; {}", fit_parameters(GENUS), describe(&o)),
+                    format!("{}; {}", studio.fit_parameters(GENUS), describe(&o)),
                     bytes,
                 ))
             }),
@@ -451,7 +461,7 @@ pub fn jobs() -> Vec<Job3d> {
                 Ok(png(
                     &file,
                     format!("Gallery: the initial model of genus {genus}, {what}."),
-                    format!("{}; {}", fit_parameters(genus), describe(&o)),
+                    format!("{}; {}", studio.fit_parameters(genus), describe(&o)),
                     bytes,
                 ))
             }),
@@ -483,7 +493,7 @@ pub fn jobs() -> Vec<Job3d> {
                 Ok(png(
                     file,
                     format!("Gallery: the genus-2 model, {what}."),
-                    format!("{}; {}", fit_parameters(GENUS), describe(&o)),
+                    format!("{}; {}", studio.fit_parameters(GENUS), describe(&o)),
                     bytes,
                 ))
             }),
