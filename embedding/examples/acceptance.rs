@@ -6,8 +6,8 @@
 //!
 //! `cargo run --release -p embedding --example acceptance [SCALE] [--large]`: SCALE (default 1)
 //! multiplies each mesh's resolution; `--large` adds the 200 000-triangle plate (minutes). GRID,
-//! DISK_GRID, SMOOTHNESS and ROUNDS override `ntori fit`'s settings; DUMP=DIR writes each mesh
-//! there as OBJ.
+//! DISK_GRID, SMOOTHNESS, ROUNDS and EVEN (rounds of evening out) override `ntori fit`'s settings; DUMP=DIR writes each mesh
+//! there as OBJ; ONLY=TEXT fits only the meshes whose names contain TEXT.
 #[path = "../tests/shapes/mod.rs"]
 mod shapes;
 
@@ -43,7 +43,11 @@ fn main() {
         let plate = HoledMesh::new(4, 170).expect("a plate");
         cases.push(("genus-4 plate, large", (plate.positions, plate.triangles)));
     }
+    let only = std::env::var("ONLY").ok();
     for (name, (positions, triangles)) in &cases {
+        if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
+            continue;
+        }
         if let Ok(dir) = std::env::var("DUMP") {
             dump(
                 &std::path::Path::new(&dir).join(format!("{}.obj", name.replace([' ', ','], "-"))),
@@ -86,6 +90,7 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
     let rounds = env("ROUNDS").map_or(fit_defaults.stretch_rounds, |r| r as usize);
     let fit_settings = FitSettings {
         stretch_rounds: rounds,
+        even_rounds: env("EVEN").map_or(fit_defaults.even_rounds, |r| r as usize),
         smoothness: env("SMOOTHNESS").unwrap_or(embedding::fit::default_smoothness(grid)),
         ..fit_defaults
     };
@@ -113,6 +118,9 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
         cells_per_knot(layout.settings()),
     );
     let gauss_bonnet = sums.gauss_bonnet_error(fit.genus);
+    if let Some(e) = fit.evening {
+        println!("  evened out: {e:?}");
+    }
     if let Some(d) = fit.parameterization.map_distortion {
         println!("  map distortion: {d:?}");
     }

@@ -223,6 +223,10 @@ pub struct FitSettings {
     /// The most Gauss–Seidel sweeps per round of a genus-0 mesh's map onto the sphere (it stops
     /// earlier once converged). Maps onto the polygon are solved by Newton's method instead.
     pub sweeps: usize,
+    /// Rounds of evening a user's mesh out along its own surface before its map onto the polygon
+    /// is made ([`crate::mesh_fit::mesh_model`], genus ≥ 1; 0: the map follows the mesh's own
+    /// triangles). The plates are even already and ignore it.
+    pub even_rounds: usize,
 }
 
 impl Default for FitSettings {
@@ -232,6 +236,7 @@ impl Default for FitSettings {
             patch_weight: 1.0,
             stretch_rounds: 1,
             sweeps: 5000,
+            even_rounds: crate::mesh_fit::EVEN_ROUNDS,
         }
     }
 }
@@ -1126,7 +1131,7 @@ impl Lifts {
     }
 
     /// A triangle's corners in its frame.
-    fn corner_positions(&self, t: &[(u32, Lft); 3]) -> [Complex64; 3] {
+    pub(crate) fn corner_positions(&self, t: &[(u32, Lft); 3]) -> [Complex64; 3] {
         t.map(|(v, g)| g.apply(self.home[v as usize]))
     }
 

@@ -336,11 +336,10 @@ fn an_evened_pretzel_fits_within_issue_14s_targets() {
 
 /// Marching tetrahedra's meshes of a pretzel (genus 3) and of a cube bored through by three
 /// tunnels (genus 5): irregular triangles, long thin ones among them, and high-valence vertices.
-/// Their maps are found, with the right genus, no fold and loops whose words close up. The fitted
-/// shape is not yet close (measured at finer meshes with `examples/acceptance.rs`: 6% and 27% of
-/// the diagonal, Hausdorff, and Gauss–Bonnet off by 1e-3 to 1e-2: the maps' triangles are 9 to 32
-/// times longer one way than the other on average, where thin tubes meet the regular polygon's fat
-/// ones), and `ntori fit`'s shape checks refuse them; this holds the map's part.
+/// Their maps are found, with the right genus, no fold and loops whose words close up. (How close
+/// the pretzel's shape comes is the next test's; the cube's is not yet close: 3.8% of the diagonal
+/// apart at cell 0.1 with `examples/acceptance.rs`, from 34% before its map was made from the mesh
+/// evened out.)
 #[test]
 fn irregular_meshes_of_other_shapes_fit_without_folds() {
     for (genus, (positions, triangles)) in [
@@ -358,6 +357,39 @@ fn irregular_meshes_of_other_shapes_fit_without_folds() {
         assert_eq!(fit.loops.paths.len(), 2 * genus as usize);
         assert_eq!(fit.parameterization.points.len(), positions.len());
     }
+}
+
+/// Marching tetrahedra's raw pretzel (genus 3, 9 894 vertices, 28% of its triangles with an angle
+/// under 20°, 23% of its vertices without six neighbours). A map made from its own triangles
+/// follows their grid-made directions, which turn from place to place, and the surface fitted
+/// through its vertices at those parameters wrinkled: 3.1% of the diagonal from the mesh
+/// (Hausdorff), Gauss–Bonnet off by 2.9e-2, 12 735 crossing triangle pairs. A second map, made
+/// from the mesh evened out along itself (`mesh::even`), lets the fit through the same vertices
+/// come within 0.21% of them at most (0.99% through the first), so it is kept: 0.67% and 6.6e-7
+/// (`examples/acceptance.rs`; issue 14's 0.5% is not met yet: the mesh's own vertices sit up to a
+/// tenth of a cell off the pretzel, and the fit follows).
+#[test]
+fn a_raw_marching_tetrahedra_mesh_fits_through_a_map_of_it_evened_out() {
+    use embedding::quality;
+    let (positions, triangles) = shapes::pretzel(0.12);
+    let (settings, fit_settings) = embedding::mesh_fit::default_settings(3);
+    let fit = mesh_model(&positions, &triangles, settings, fit_settings, &|_| {}).unwrap();
+    assert_eq!((fit.genus, fit.parameterization.folded), (3, 0));
+    let evening = fit
+        .evening
+        .expect("thin, irregular triangles: a second map evened out");
+    assert!(evening.moved > positions.len() / 2, "{evening:?}");
+    assert!(
+        evening.kept && evening.max_residual_as_it_is > 3.0 * evening.max_residual_evened,
+        "{evening:?}"
+    );
+    assert_eq!(fit.max_residual, evening.max_residual_evened);
+    let d = quality::hausdorff_to_mesh(&fit.surface, 32, &positions, &triangles).unwrap();
+    let distance = d.symmetric / fit.mesh_diagonal;
+    let error = gauss_bonnet_error(&fit.surface, 3);
+    eprintln!("Hausdorff {distance:.4} of the diagonal, Gauss–Bonnet {error:e}, {evening:?}");
+    assert!(distance < 0.01, "Hausdorff {distance} of the diagonal");
+    assert!(error < 1e-5, "Gauss–Bonnet {error:e}");
 }
 
 /// Marching tetrahedra's cube with tunnels at cell 0.2 (4 200 triangles, genus 5): the sweeps carry

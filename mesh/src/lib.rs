@@ -23,6 +23,7 @@
 //! ```
 
 pub mod cell_complex;
+pub mod even;
 pub mod halfedge;
 pub mod schema;
 pub mod shape;

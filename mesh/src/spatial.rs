@@ -476,6 +476,31 @@ pub fn closest_point_on_triangle(p: [f64; 3], t: [[f64; 3]; 3]) -> [f64; 3] {
         .unwrap_or(t[0])
 }
 
+/// The barycentric coordinates of `p` (a point of the triangle's plane) in the triangle; a
+/// degenerate triangle's point is given to its nearest corner.
+///
+/// ```
+/// use mesh::spatial::barycentric;
+/// let t = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
+/// assert_eq!(barycentric([0.5, 0.5, 0.0], t), [0.5, 0.25, 0.25]);
+/// ```
+pub fn barycentric(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> [f64; 3] {
+    let (ab, ac, ap) = (sub(&b, &a), sub(&c, &a), sub(&p, &a));
+    let (d00, d01, d11) = (dot(&ab, &ab), dot(&ab, &ac), dot(&ac, &ac));
+    let (d20, d21) = (dot(&ap, &ab), dot(&ap, &ac));
+    let det = d00 * d11 - d01 * d01;
+    if det <= f64::EPSILON * d00 * d11 || !det.is_finite() {
+        let d = [a, b, c].map(|q| distance_2(&p, &q));
+        let k = (0..3).min_by(|&i, &j| d[i].total_cmp(&d[j])).unwrap_or(0);
+        let mut w = [0.0; 3];
+        w[k] = 1.0;
+        return w;
+    }
+    let v = (d11 * d20 - d01 * d21) / det;
+    let w = (d00 * d21 - d01 * d20) / det;
+    [1.0 - v - w, v, w]
+}
+
 /// Ericson's ClosestPtPointTriangle, names as in the book; may return NaN on a degenerate triangle.
 fn voronoi_closest_point(p: &Point, [a, b, c]: &[Point; 3]) -> Point {
     let ab = sub(b, a);

@@ -689,3 +689,159 @@ proptest! {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Evening a mesh out along its own surface (mesh::even)
+// ---------------------------------------------------------------------------------------------------
+
+/// Triangles with an angle under 20°.
+fn thin_triangles(positions: &[P], triangles: &[[u32; 3]]) -> usize {
+    mesh::mesh_shape(positions, triangles).unwrap().below_20
+}
+
+fn unit_normal(p: [P; 3]) -> P {
+    let (a, b) = (
+        [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]],
+        [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]],
+    );
+    normalize([
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ])
+}
+
+/// Checks what evening promises: every vertex on its host triangle of the original mesh (the
+/// barycentric coordinates in [0, 1] reproduce it), no triangle turned against its original
+/// normal, and the vertices that were not free exactly where they were.
+fn assert_evened_on_the_mesh(original: &Mesh, evened: &mesh::even::Evened) {
+    let (positions, triangles) = original;
+    for (v, (&(t, b), p)) in evened.hosts.iter().zip(&evened.positions).enumerate() {
+        let corners = triangles[t as usize].map(|c| positions[c as usize]);
+        assert!(
+            b.iter().all(|&x| x > -1e-9 && x < 1.0 + 1e-9),
+            "vertex {v}: {b:?}"
+        );
+        for axis in 0..3 {
+            let q: f64 = (0..3).map(|k| b[k] * corners[k][axis]).sum();
+            assert!(
+                (q - p[axis]).abs() < 1e-9,
+                "vertex {v} is off its host triangle {t}"
+            );
+        }
+    }
+    for (i, t) in triangles.iter().enumerate() {
+        let before = unit_normal(t.map(|c| positions[c as usize]));
+        let after = unit_normal(t.map(|c| evened.positions[c as usize]));
+        let turn: f64 = (0..3).map(|k| before[k] * after[k]).sum();
+        assert!(turn > 0.0, "triangle {i} turned over");
+    }
+}
+
+#[test]
+fn a_mesh_without_thin_triangles_is_left_as_it_is() {
+    let sphere = icosphere(3);
+    assert_eq!(thin_triangles(&sphere.0, &sphere.1), 0);
+    let evened = mesh::even::even_out(&sphere.0, &sphere.1, 10);
+    assert_eq!((evened.free, evened.largest_move), (0, 0.0));
+    assert_eq!(evened.positions, sphere.0);
+}
+
+/// The smallest angle of any triangle, in degrees.
+fn smallest_angle(positions: &[P], triangles: &[[u32; 3]]) -> f64 {
+    mesh::mesh_shape(positions, triangles)
+        .unwrap()
+        .smallest_angle
+}
+
+/// A number in [−1, 1) from a seed and an index (splitmix64), for jitter.
+fn jitter(seed: u64, i: u64) -> f64 {
+    let mut z = seed.wrapping_add(i.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+}
+
+/// A box ten times longer than it is wide, each face a grid whose lines across the long axis are
+/// moved at random by up to 0.4 of their spacing (edges included, so the box's edges stay
+/// straight): thin, irregular triangles on the long faces. Evening rounds them (the smallest angle
+/// grows), the vertices on the box's edges (sharp: 90°) stay where they are, and the rest slide
+/// within their faces.
+#[test]
+fn a_long_box_keeps_its_edges_and_its_faces_flat() {
+    let n = 6;
+    let (cube_positions, triangles) = cube(n);
+    let stretch = |x: f64| {
+        // x = (2i − n)/n on the grid; inner lines are jittered, the ends stay.
+        let i = ((x + 1.0) * f64::from(n) / 2.0).round() as u64;
+        let moved = if i == 0 || i == u64::from(n) {
+            x
+        } else {
+            x + 0.4 * jitter(7, i) * 2.0 / f64::from(n)
+        };
+        10.0 * moved
+    };
+    let positions: Vec<P> = cube_positions
+        .iter()
+        .map(|p| [stretch(p[0]), p[1], p[2]])
+        .collect();
+    let box_mesh = (positions.clone(), triangles.clone());
+    let before = smallest_angle(&positions, &triangles);
+    let evened = mesh::even::even_out(&positions, &triangles, 10);
+    assert_evened_on_the_mesh(&box_mesh, &evened);
+    let after = smallest_angle(&evened.positions, &triangles);
+    assert!(after > before, "smallest angle {before}° -> {after}°");
+    assert!(evened.pinned > 0 && evened.free > 0);
+    let extreme = |p: &P| {
+        (0..3)
+            .filter(|&a| (p[a].abs() - [10.0, 1.0, 1.0][a]).abs() < 1e-12)
+            .count()
+    };
+    for (v, (p, q)) in positions.iter().zip(&evened.positions).enumerate() {
+        // On an edge of the box (two coordinates at their extremes): not moved. On a face: still on
+        // that face.
+        match extreme(p) {
+            2.. => assert_eq!(p, q, "edge vertex {v} moved"),
+            _ => assert!(extreme(q) >= 1, "vertex {v} left the box's faces: {q:?}"),
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Tori whose grid is far finer around the ring than round the tube, each vertex moved along
+    /// the ring (on the smooth torus) by up to 0.45 of the spacing at random: thin, irregular
+    /// triangles and no sharp edges. Evened for any number of rounds, every vertex stays on the
+    /// original mesh, no triangle turns over, and the smallest angle grows.
+    #[test]
+    fn evening_keeps_a_jittered_torus_on_itself_and_rounds_its_triangles(
+        n in 100u32..200,
+        m in 10u32..15,
+        rounds in 1usize..16,
+        seed in any::<u64>(),
+    ) {
+        let tau = std::f64::consts::TAU;
+        let (_, triangles) = torus(n, m);
+        let mut positions = Vec::new();
+        for i in 0..n {
+            for j in 0..m {
+                let shift = 0.45 * jitter(seed, u64::from(i * m + j));
+                let (a, b) = (
+                    tau * (f64::from(i) + shift) / f64::from(n),
+                    tau * f64::from(j) / f64::from(m),
+                );
+                let r = 2.0 + 0.7 * b.cos();
+                positions.push([r * a.cos(), r * a.sin(), 0.7 * b.sin()]);
+            }
+        }
+        let torus_mesh = (positions, triangles);
+        let before = smallest_angle(&torus_mesh.0, &torus_mesh.1);
+        let evened = mesh::even::even_out(&torus_mesh.0, &torus_mesh.1, rounds);
+        assert_evened_on_the_mesh(&torus_mesh, &evened);
+        prop_assert_eq!(evened.pinned, 0);
+        let after = smallest_angle(&evened.positions, &torus_mesh.1);
+        prop_assert!(after > before, "smallest angle {}° -> {}°", before, after);
+    }
+}

@@ -24,7 +24,11 @@ use super::{FitArgs, FitProgress};
 /// gets the side pairing of the polygon it crosses. The mesh is then mapped onto the surface by the
 /// same relaxation and fit as `ntori new`, with the same checks: folded triangles (0: a bijection),
 /// the residual at the mesh vertices, Gauss–Bonnet, and the shape checks (patch disagreement, the
-/// largest |κ| against the mesh's own, normals against the mesh's, self-intersections). If a check
+/// largest |κ| against the mesh's own, normals against the mesh's, self-intersections). A mesh with
+/// many long thin irregular triangles (a fifth or more with an angle under 20°, as marching cubes
+/// and scanners make) is also mapped evened out along its own surface, a map that does not follow
+/// the triangles' directions; the fit's data stay the mesh's own vertices, and the map whose fit
+/// comes closer to them is kept. If a check
 /// fails, no model is written (unless --keep-failed) and the exit status is 3. A genus-0 mesh is
 /// mapped onto the sphere instead (no loops).
 ///
@@ -60,6 +64,11 @@ pub struct Args {
     #[arg(long, value_name = "L", requires = "cage",
           value_parser = clap::value_parser!(u32).range(1..=i64::from(cage::MAX_CAGE_LEVEL)))]
     cage_level: Option<u32>,
+    /// Rounds of evening out a mesh with many long thin irregular triangles for a second map (0:
+    /// map it once, as it is).
+    #[arg(long, value_name = "N", default_value_t = embedding::mesh_fit::EVEN_ROUNDS as u32,
+          value_parser = clap::value_parser!(u32).range(0..=1000))]
+    even_rounds: u32,
     #[command(flatten)]
     spline: FitArgs,
     /// Print the report as JSON.
@@ -94,7 +103,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // chart: the genus-2 slab cage at 20 / 32 fits with patches 0.84% / 0.42% apart, normals
     // 4.5° / 1.6° off its limit normals at the 90th percentile. A user's mesh gets finer disk
     // charts, as `new`'s plates do (`mesh_fit::default_settings` says what was measured).
-    let (settings, fit) = if cage.is_some() {
+    let (settings, mut fit) = if cage.is_some() {
         args.spline
             .settings(embedding::SplineSettings::default().grid, |_| None)
     } else {
@@ -102,6 +111,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             mesh_fit_disk_grid(valid.genus, grid)
         })
     };
+    fit.even_rounds = args.even_rounds as usize;
     let progress = FitProgress::new(args.quiet);
     let fitted = mesh_model(
         &valid.positions,
@@ -122,6 +132,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ntori::io::model_file::save_new(&args.output, &fitted.surface)?;
     }
     let report = FitReport {
+        evening: fitted.evening.map(|e| EveningReport {
+            rounds: e.rounds,
+            moved: e.moved,
+            pinned: e.pinned,
+            largest_move: e.largest_move / fitted.mesh_diagonal,
+            max_residual_evened: e.max_residual_evened / fitted.mesh_diagonal,
+            max_residual_as_it_is: e.max_residual_as_it_is / fitted.mesh_diagonal,
+            kept: e.kept,
+        }),
         input: InputReport {
             path: args.mesh.display().to_string(),
             merged_vertices: merged,
@@ -217,6 +236,8 @@ fn as_fitted<'a>(
 struct FitReport<'a> {
     input: InputReport,
     loops: LoopsReport,
+    /// How the mesh was evened out for its map, where it has long thin triangles.
+    evening: Option<EveningReport>,
     fit: NewReport,
     #[serde(skip)]
     output: &'a Path,
@@ -235,6 +256,23 @@ struct InputReport {
     flipped: bool,
     /// With --cage: the cage and its refinement.
     cage: Option<CageReport>,
+}
+
+/// Vertices near long thin triangles slid along the mesh for a second map (the fit's data stay
+/// the mesh's own vertices), and which map was kept.
+#[derive(Serialize)]
+struct EveningReport {
+    rounds: usize,
+    /// Vertices that moved, and vertices near thin triangles held on sharp edges.
+    moved: usize,
+    pinned: usize,
+    /// The largest move, as a fraction of the mesh's bounding-box diagonal.
+    largest_move: f64,
+    /// The largest residual of the fit through each map (fractions of the diagonal), and whether
+    /// the evened map's (the closer) was kept.
+    max_residual_evened: f64,
+    max_residual_as_it_is: f64,
+    kept: bool,
 }
 
 /// The loop system the map was built on.
@@ -315,12 +353,33 @@ impl Report for FitReport<'_> {
                 self.loops.base_vertex,
             )
         };
+        let evening = self.evening.as_ref().map_or(String::new(), |e| {
+            let pinned = if e.pinned > 0 {
+                format!(", {} held on sharp edges", e.pinned)
+            } else {
+                String::new()
+            };
+            let (kept, other) = if e.kept {
+                ("the mesh evened out", "as it is")
+            } else {
+                ("the mesh as it is", "evened out")
+            };
+            format!(
+                "map: made from {kept} (its fit's largest residual {:.3}% of the diagonal, {:.3}% \
+                 {other}: {} vertices near long thin triangles slid along it, up to {:.2}% of the \
+                 diagonal{pinned}); the fit's data are its own vertices\n",
+                100.0 * e.max_residual_evened.min(e.max_residual_as_it_is),
+                100.0 * e.max_residual_evened.max(e.max_residual_as_it_is),
+                e.moved,
+                100.0 * e.largest_move
+            )
+        });
         let cage = i.cage.as_ref().map_or(String::new(), |c| {
             format!(
                 "cage: {} faces ({} not quads), refined {} times by OpenSubdiv to its limit surface ({} vertices)\n",
                 c.faces, c.non_quads, c.level, c.limit_vertices
             )
         });
-        format!("read {}{notes}\n{cage}{loops}\n", i.path) + &self.fit.to_text() + &outcome
+        format!("read {}{notes}\n{cage}{loops}\n{evening}", i.path) + &self.fit.to_text() + &outcome
     }
 }
