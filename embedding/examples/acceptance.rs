@@ -1,5 +1,5 @@
 //! Issue 14's acceptance measures on meshes that are not plates: a knotted tube (genus 1), a
-//! pretzel (genus 3), a cube with tunnels (genus 5), and a plate of about 200 000 triangles, each
+//! pretzel (genus 3), a cube with tunnels (genus 5), an animal with thin legs (genus 0), and a plate of about 200 000 triangles, each
 //! fitted as a user's mesh (`mesh_model`, `ntori fit`'s grid): folds, the two-sided Hausdorff
 //! distance between the input and the surface's t = 32 tessellation, the normals against the mesh's
 //! own at the 95th percentile, Gauss–Bonnet, the loops' canonical words, and the time.
@@ -38,6 +38,7 @@ fn main() {
             "cube with tunnels, evened out",
             shapes::even_cube_with_tunnels(0.1 / scale, 10),
         ),
+        ("animal", shapes::animal(0.07 / scale)),
     ];
     if args.iter().any(|a| a == "--large") {
         let plate = HoledMesh::new(4, 170).expect("a plate");

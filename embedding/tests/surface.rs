@@ -989,6 +989,25 @@ fn stencils_give_the_same_numbers_on_all_cores() {
         .unwrap();
     let both = |f: &(dyn Fn() -> Vec<Point3> + Sync)| (one_thread.install(f), all_cores.install(f));
 
+    // The column index: the same on all cores, and for each control point exactly the rows that
+    // use it, in order.
+    let stencil = Stencil::build(&layout, &points);
+    let count = layout.control_count();
+    let index = one_thread.install(|| stencil.column_index(count));
+    assert_eq!(index, all_cores.install(|| stencil.column_index(count)));
+    let mut users = vec![Vec::new(); count];
+    for r in 0..stencil.rows() {
+        for (c, w) in stencil.row(r) {
+            users[c as usize].push((r as u32, w));
+        }
+    }
+    for (c, column) in users.iter().enumerate() {
+        assert!(
+            stencil.column(&index, c).eq(column.iter().copied()),
+            "control point {c}"
+        );
+    }
+
     let (one, all) = both(&|| {
         let stencil = Stencil::build_parallel(&layout, &points);
         assert_eq!(stencil, Stencil::build(&layout, &points));
