@@ -72,7 +72,8 @@ pub struct Parameterization {
     /// relaxed by sweeps alone).
     pub newton: Option<Convergence>,
     /// The map's distortion where there is no cut disk to measure it on (a user's mesh, mapped
-    /// closed: each triangle in the frame its corners were solved in); `None` otherwise.
+    /// closed: each triangle in the frame its corners were solved in, or on the sphere against its
+    /// chord triangle); `None` otherwise.
     pub map_distortion: Option<Distortion>,
 }
 
@@ -94,8 +95,8 @@ pub struct Distortion {
 
 impl Parameterization {
     /// The map's [`Distortion`] over the cut disk's triangles, or for a user's mesh (no disk) over
-    /// its own (`None` for the sphere). `positions` are the mesh's; `geometry` the model's (the
-    /// polygon's).
+    /// its own ([`Parameterization::map_distortion`]). `positions` are the mesh's; `geometry` the
+    /// model's (the polygon's; unused without a disk).
     pub fn distortion(&self, positions: &[Point3], geometry: Geometry) -> Option<Distortion> {
         let Some(disk) = self.disk.as_ref() else {
             return self.map_distortion;

@@ -326,7 +326,7 @@ struct Mapped {
     sweeps: usize,
     /// Newton's solve of the polygon's map (none for the sphere's).
     solved: Option<Convergence>,
-    /// The polygon map's distortion (none for the sphere's).
+    /// The map's distortion (the polygon's or the sphere's).
     distortion: Option<Distortion>,
     loops: LoopReport,
     /// Whether the map was made from the mesh evened out, and how.
@@ -361,7 +361,7 @@ fn map_to_sphere(
         folded: map.folded,
         sweeps: map.sweeps,
         solved: None,
-        distortion: None,
+        distortion: map.distortion,
         loops: LoopReport {
             base: 0,
             paths: Vec::new(),
