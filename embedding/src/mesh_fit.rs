@@ -200,7 +200,7 @@ pub fn mesh_model(
     let input = MeshInput {
         atlas: &atlas,
         layout: &layout,
-        he: &he,
+        genus,
         positions,
         areas: &areas,
     };
@@ -208,65 +208,48 @@ pub fn mesh_model(
         let mapped = map_to_sphere(&atlas, positions, triangles, &areas, fit_settings, progress)?;
         return finish(&input, mapped, fit_settings, progress);
     };
-    let plain = || {
-        let mapped = map_to_polygon(
-            &atlas,
-            polygon,
-            &he,
-            MapInput {
-                positions,
-                triangles,
-                areas: &areas,
-                samples: None,
-            },
-            fit_settings,
-            progress,
-        )?;
+    // The map made from `map_positions` (with their `map_areas`), the mesh's own vertices placed
+    // through it where those differ (`samples`), and the fit through them.
+    let fit_through = |map_positions: &[Point3], map_areas: &[f64], samples| {
+        let map_input = MapInput {
+            positions: map_positions,
+            triangles,
+            areas: map_areas,
+            samples,
+        };
+        let mapped = map_to_polygon(&atlas, polygon, &he, map_input, fit_settings, progress)?;
         finish(&input, mapped, fit_settings, progress)
     };
     let Some(evening) = even_out(positions, triangles, fit_settings.even_rounds) else {
-        return plain();
+        return fit_through(positions, &areas, None);
     };
     // Evening helps where the mesh's thin triangles turn from place to place (marching cubes) and
     // can blur a map that was smooth already; the fit through the mesh's own vertices says which:
     // the map whose parameters let a smooth surface come closer to them is kept.
     let evened_areas = vertex_areas(&evening.positions, triangles);
-    let mut mapped = map_to_polygon(
-        &atlas,
-        polygon,
-        &he,
-        MapInput {
-            positions: &evening.positions,
-            triangles,
-            areas: &evened_areas,
-            samples: Some(positions),
-        },
-        fit_settings,
-        progress,
-    )?;
-    let mut report = evening.report;
-    mapped.evening = Some(report);
-    let evened = finish(&input, mapped, fit_settings, progress)?;
-    let mut as_it_is = plain()?;
-    report.max_residual_evened = evened.max_residual;
-    report.max_residual_as_it_is = as_it_is.max_residual;
-    report.kept = evened.max_residual < as_it_is.max_residual;
-    if report.kept {
-        Ok(MeshFit {
-            evening: Some(report),
-            ..evened
-        })
-    } else {
-        as_it_is.evening = Some(report);
-        Ok(as_it_is)
-    }
+    let evened = fit_through(&evening.positions, &evened_areas, Some(positions))?;
+    let as_it_is = fit_through(positions, &areas, None)?;
+    let report = EvenReport {
+        rounds: evening.rounds,
+        moved: evening.moved,
+        pinned: evening.pinned,
+        largest_move: evening.largest_move,
+        max_residual_evened: evened.max_residual,
+        max_residual_as_it_is: as_it_is.max_residual,
+        kept: evened.max_residual < as_it_is.max_residual,
+    };
+    let kept = if report.kept { evened } else { as_it_is };
+    Ok(MeshFit {
+        evening: Some(report),
+        ..kept
+    })
 }
 
 /// The user's mesh and what is made of it once, for [`finish`].
 struct MeshInput<'a> {
     atlas: &'a Arc<Atlas>,
     layout: &'a Layout<'a>,
-    he: &'a HalfEdgeMesh,
+    genus: u32,
     positions: &'a [Point3],
     areas: &'a [f64],
 }
@@ -281,7 +264,7 @@ fn finish(
     let MeshInput {
         atlas,
         layout,
-        he,
+        genus,
         positions,
         areas,
     } = *input;
@@ -297,7 +280,7 @@ fn finish(
     let surface = Surface::new(Arc::clone(atlas), layout.settings(), control)?;
     Ok(MeshFit {
         surface,
-        genus: he.topology().genus.unwrap_or(0),
+        genus,
         parameterization: Parameterization {
             points,
             disk: None,
@@ -310,7 +293,7 @@ fn finish(
             map_distortion: mapped.distortion,
         },
         loops: mapped.loops,
-        evening: mapped.evening,
+        evening: None,
         rms_residual: (sum / positions.len() as f64).sqrt(),
         max_residual: max,
         mesh_diagonal: diagonal(positions),
@@ -329,8 +312,6 @@ struct Mapped {
     /// The map's distortion (the polygon's or the sphere's).
     distortion: Option<Distortion>,
     loops: LoopReport,
-    /// Whether the map was made from the mesh evened out, and how.
-    evening: Option<EvenReport>,
 }
 
 /// Genus 0: the mesh mapped onto the unit sphere ([`sphere_map`]), read in the sphere's two caps.
@@ -369,7 +350,6 @@ fn map_to_sphere(
             canonical: Vec::new(),
             closure_error: 0.0,
         },
-        evening: None,
     })
 }
 
@@ -434,7 +414,6 @@ fn map_to_polygon(
         solved: Some(solved),
         distortion,
         loops,
-        evening: None,
     })
 }
 
@@ -520,22 +499,20 @@ fn even_out(positions: &[Point3], triangles: &[[u32; 3]], rounds: usize) -> Opti
     }
     Some(Evening {
         positions: evened.positions.into_iter().map(Point3::from).collect(),
-        report: EvenReport {
-            rounds,
-            moved: evened.free,
-            pinned: evened.pinned,
-            largest_move: evened.largest_move,
-            max_residual_evened: f64::NAN,
-            max_residual_as_it_is: f64::NAN,
-            kept: false,
-        },
+        rounds,
+        moved: evened.free,
+        pinned: evened.pinned,
+        largest_move: evened.largest_move,
     })
 }
 
-/// The evened mesh and what evening did.
+/// The evened mesh and what evening did (see [`EvenReport`]).
 struct Evening {
     positions: Vec<Point3>,
-    report: EvenReport,
+    rounds: usize,
+    moved: usize,
+    pinned: usize,
+    largest_move: f64,
 }
 
 /// What evening the mesh out for its map did (the map is made from the evened vertices; the fit's
