@@ -199,24 +199,7 @@ pub(crate) fn solve(
         let (step, drift_step) = newton_step(&current.lu, lifts.home.len(), hyperbolic, &f)?;
         let (start, start_drift) = (lifts.home.clone(), drift);
         let before = norm2(&f);
-        // A step longer than MAX_FRAME_STEP in some vertex's frame is shortened as a whole (not
-        // vertex by vertex, which turns it off Newton's direction: from Floater's map at genus 8
-        // that wandered into a tangled map whose ‖F‖₂ still fell).
-        let longest = if hyperbolic {
-            lifts
-                .home
-                .iter()
-                .zip(&step)
-                .map(|(z, d)| d.norm() / (1.0 - z.norm_sqr()))
-                .fold(0.0, f64::max)
-        } else {
-            0.0
-        };
-        let mut t = if longest > MAX_FRAME_STEP {
-            MAX_FRAME_STEP / longest
-        } else {
-            1.0
-        };
+        let mut t = whole_step(&lifts.home, &step, hyperbolic);
         let mut accepted = None;
         for _ in 0..MAX_HALVINGS {
             for ((h, z), d) in lifts.home.iter_mut().zip(&start).zip(&step) {
@@ -271,6 +254,26 @@ fn advance(z: Complex64, d: Complex64, hyperbolic: bool) -> Complex64 {
     }
     let frame = d / (1.0 - z.norm_sqr());
     (frame + z) / (Complex64::ONE + z.conj() * frame)
+}
+
+/// The part of the Newton step `step` that the line search starts from: all of it, unless it
+/// moves some vertex further than [`MAX_FRAME_STEP`] in its frame; then the whole step is shortened
+/// to that (not vertex by vertex, which turns it off Newton's direction: from Floater's map at
+/// genus 8 that wandered into a tangled map whose ‖F‖₂ still fell).
+fn whole_step(home: &[Complex64], step: &[Complex64], hyperbolic: bool) -> f64 {
+    if !hyperbolic {
+        return 1.0;
+    }
+    let longest = home
+        .iter()
+        .zip(step)
+        .map(|(z, d)| d.norm() / (1.0 - z.norm_sqr()))
+        .fold(0.0, f64::max);
+    if longest > MAX_FRAME_STEP {
+        MAX_FRAME_STEP / longest
+    } else {
+        1.0
+    }
 }
 
 /// The longest step a vertex takes at once in its own frame (frame units: 1 is the rim), as the
