@@ -96,7 +96,7 @@ pub struct Distortion {
 impl Parameterization {
     /// The map's [`Distortion`] over the cut disk's triangles, or for a user's mesh (no disk) over
     /// its own ([`Parameterization::map_distortion`]). `positions` are the mesh's; `geometry` the
-    /// model's (the polygon's; unused without a disk).
+    /// model's (`Atlas::geometry`; unused without a disk).
     pub fn distortion(&self, positions: &[Point3], geometry: Geometry) -> Option<Distortion> {
         let Some(disk) = self.disk.as_ref() else {
             return self.map_distortion;

@@ -434,13 +434,7 @@ pub fn check(
         control_points: surface.control_points().len(),
         sweeps: parameterization.sweeps,
         newton: parameterization.newton,
-        // The sphere (genus 0) has no polygon and no cut disk: its map's own distortion.
-        distortion: surface
-            .atlas()
-            .polygon()
-            .map_or(parameterization.map_distortion, |p| {
-                parameterization.distortion(positions, p.geometry())
-            }),
+        distortion: parameterization.distortion(positions, surface.atlas().geometry()),
         folded_triangles: parameterization.folded,
         rms_residual: rms_residual / mesh_diagonal,
         max_residual: max_residual / mesh_diagonal,
