@@ -815,12 +815,13 @@ fn flatten(
     let (disk, flat, mut lifts) = floater_lifts(polygon, mesh)?;
     let rounds = stretch_rounds + 1;
     progress(FitStage::Relaxing { round: 1, rounds });
-    let mut solved = lifts.settle(hyperbolic)?;
+    let mut kept = None;
+    let mut solved = lifts.settle(hyperbolic, &mut kept)?;
     for round in 2..=rounds {
         progress(FitStage::Relaxing { round, rounds });
         let stretch = lifts.stretch(&mesh.positions, hyperbolic);
         lifts.reweight(&stretch);
-        solved = solved.then(lifts.settle(hyperbolic)?);
+        solved = solved.then(lifts.settle(hyperbolic, &mut kept)?);
     }
     let folded = lifts.folded_triangles(hyperbolic);
     let copies = (0..disk.original.len() as u32)
@@ -1023,11 +1024,26 @@ impl Lifts {
         }
     }
 
-    /// The map at its fixed point: [`WARMUP_SWEEPS`] sweeps to smooth the start, then Newton's
-    /// method to [`RELAX_TOLERANCE`] (see [`crate::harmonic`]).
-    pub(crate) fn settle(&mut self, hyperbolic: bool) -> Result<Convergence, EmbeddingError> {
-        let swept = self.relax(hyperbolic, WARMUP_SWEEPS, RELAX_TOLERANCE);
-        let mut solved = crate::harmonic::solve(self, hyperbolic, RELAX_TOLERANCE)?;
+    /// The map at its fixed point by Newton's method to [`RELAX_TOLERANCE`] (see
+    /// [`crate::harmonic`]), which leaves its last Jacobian in `kept` for the next round.
+    ///
+    /// A first round (nothing kept) starts from Floater's map, far from the fixed point:
+    /// [`WARMUP_SWEEPS`] sweeps smooth it first. A later round starts at the round before's fixed
+    /// point, its weights changed a little: there the kept Jacobian's chord steps take it most of
+    /// the way and sweeps only slow it down. Measured on `ntori new`'s second round: genus 10
+    /// 1.24 s (300 sweeps, 2 factorizations) → 0.57 s (none, 1), genus 32 12.2 s → 7.0 s; the map
+    /// the same to the tolerance.
+    pub(crate) fn settle(
+        &mut self,
+        hyperbolic: bool,
+        kept: &mut Option<crate::harmonic::KeptJacobian>,
+    ) -> Result<Convergence, EmbeddingError> {
+        let swept = if kept.is_none() {
+            self.relax(hyperbolic, WARMUP_SWEEPS, RELAX_TOLERANCE)
+        } else {
+            0
+        };
+        let mut solved = crate::harmonic::solve(self, hyperbolic, RELAX_TOLERANCE, kept)?;
         solved.sweeps += swept;
         Ok(solved)
     }

@@ -163,6 +163,7 @@ pub(crate) fn solve(
     lifts: &mut Lifts,
     hyperbolic: bool,
     tolerance: f64,
+    kept: &mut Option<KeptJacobian>,
 ) -> Result<Convergence, EmbeddingError> {
     let mut drift = Complex64::ZERO;
     let mut f = residuals(lifts, hyperbolic, drift);
@@ -172,8 +173,17 @@ pub(crate) fn solve(
         sweeps: 0,
         residual: max_norm(&f),
     };
-    let mut factor: Option<Factor> = None;
-    let mut symbolic = None;
+    let (mut factor, mut symbolic) = match kept.take() {
+        Some(k) if k.vertices == lifts.home.len() => (
+            Some(Factor {
+                lu: k.lu,
+                fresh: false,
+            }),
+            Some(k.symbolic),
+        ),
+        _ => (None, None),
+    };
+    let mut last = None;
     while report.residual > tolerance {
         if report.steps == MAX_STEPS {
             return Err(EmbeddingError::Parameterization(format!(
@@ -222,6 +232,8 @@ pub(crate) fn solve(
                         fresh: false,
                         ..current
                     });
+                } else {
+                    last = Some(current.lu);
                 }
             }
             None => {
@@ -235,7 +247,24 @@ pub(crate) fn solve(
         }
         report.residual = max_norm(&f);
     }
+    *kept = factor
+        .map(|f| f.lu)
+        .or(last)
+        .zip(symbolic)
+        .map(|(lu, symbolic)| KeptJacobian {
+            lu,
+            symbolic,
+            vertices: lifts.home.len(),
+        });
     Ok(report)
+}
+
+/// A factored Jacobian kept from one solve for the next (a later round's map, whose weights differ
+/// a little): its chord steps are tried before a fresh factorization.
+pub(crate) struct KeptJacobian {
+    lu: Lu<usize, f64>,
+    symbolic: SymbolicLu<usize>,
+    vertices: usize,
 }
 
 /// Vertex z moved by the Newton step d. On the flat torus z + d. In the Poincaré disk the step is
@@ -348,11 +377,30 @@ mod tests {
 
     /// The plate of `genus` at `resolution`, its Floater lifts, and whether the model is hyperbolic.
     fn start(genus: u32, resolution: usize) -> (Lifts, bool) {
+        let (lifts, hyperbolic, _) = start_with_mesh(genus, resolution);
+        (lifts, hyperbolic)
+    }
+
+    /// [`start`], and the plate's vertex positions.
+    fn start_with_mesh(genus: u32, resolution: usize) -> (Lifts, bool, Vec<crate::Point3>) {
         let atlas = Atlas::new(genus).unwrap();
         let polygon = atlas.polygon().unwrap();
         let mesh = HoledMesh::new(genus, resolution).unwrap();
         let (_, _, lifts) = floater_lifts(polygon, &mesh).unwrap();
-        (lifts, polygon.geometry() == Geometry::Hyperbolic)
+        (
+            lifts,
+            polygon.geometry() == Geometry::Hyperbolic,
+            mesh.positions,
+        )
+    }
+
+    fn copy(lifts: &Lifts) -> Lifts {
+        Lifts::from_parts(
+            lifts.home.clone(),
+            lifts.neighbours.clone(),
+            lifts.corners.clone(),
+            lifts.base,
+        )
     }
 
     /// J·e against central differences of F along random directions e, at Floater's map (far from
@@ -433,13 +481,8 @@ mod tests {
     fn newton_reaches_the_sweeps_fixed_point() {
         for genus in [1, 2, 3, 6] {
             let (mut lifts, hyperbolic) = start(genus, 8);
-            let mut swept = Lifts::from_parts(
-                lifts.home.clone(),
-                lifts.neighbours.clone(),
-                lifts.corners.clone(),
-                lifts.base,
-            );
-            let solved = solve(&mut lifts, hyperbolic, 1e-12).unwrap();
+            let mut swept = copy(&lifts);
+            let solved = solve(&mut lifts, hyperbolic, 1e-12, &mut None).unwrap();
             assert!(solved.residual <= 1e-12);
             // Chord steps (with a kept factorization) are cheap; the factorizations are the cost.
             assert!(
@@ -501,9 +544,40 @@ mod tests {
     #[test]
     fn newton_takes_whole_steps_from_floater_s_map_at_genus_16() {
         let (mut lifts, hyperbolic) = start(16, 10);
-        let solved = solve(&mut lifts, hyperbolic, 1e-10).unwrap();
+        let solved = solve(&mut lifts, hyperbolic, 1e-10, &mut None).unwrap();
         assert!(solved.residual <= 1e-10, "{solved:?}");
         assert!(solved.factorizations <= 15, "{solved:?}");
         assert_eq!(lifts.folded_triangles(hyperbolic), 0);
+    }
+
+    /// A second round (the map reweighted by its stretch, as `ntori new` and `ntori fit` do) that
+    /// starts from the first round's kept Jacobian reaches the fixed point that a fresh solve
+    /// reaches, with fewer factorizations.
+    #[test]
+    fn a_kept_jacobian_takes_the_next_round_to_the_same_fixed_point() {
+        for (genus, resolution) in [(1, 12), (2, 12), (5, 10), (12, 8)] {
+            let (mut lifts, hyperbolic, positions) = start_with_mesh(genus, resolution);
+            let mut kept = None;
+            solve(&mut lifts, hyperbolic, 1e-10, &mut kept).unwrap();
+            assert!(kept.is_some(), "genus {genus}: nothing kept");
+            let stretch = lifts.stretch(&positions, hyperbolic);
+            lifts.reweight(&stretch);
+            let mut fresh = copy(&lifts);
+            let warm = solve(&mut lifts, hyperbolic, 1e-10, &mut kept).unwrap();
+            let cold = solve(&mut fresh, hyperbolic, 1e-10, &mut None).unwrap();
+            assert!(warm.residual <= 1e-10, "genus {genus}: {warm:?}");
+            assert!(
+                warm.factorizations < cold.factorizations,
+                "genus {genus}: kept {warm:?}, fresh {cold:?}"
+            );
+            let gap = lifts
+                .home
+                .iter()
+                .zip(&fresh.home)
+                .map(|(a, b)| (a - b).norm() / (1.0 - a.norm_sqr()))
+                .fold(0.0, f64::max);
+            let bound = if hyperbolic { 1e-8 } else { 1e-6 };
+            assert!(gap < bound, "genus {genus}: the two differ by {gap:e}");
+        }
     }
 }
