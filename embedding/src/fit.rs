@@ -386,9 +386,15 @@ pub const FINE_GRID: usize = 48;
 ///
 /// From genus 32 it is 16/3 of the grid (256): with today's input mesh (21 points round each hole)
 /// genus 32 read 3.37× at 128, which fails `new`'s curvature check, and at 256 0.015%, 2.88×,
-/// 0.39°, Gauss–Bonnet 1.0e-6 (63 s and 2.4 GB against 52 s and 1.7 GB). Genus 64 (8 points round
-/// each hole) still fails at 256, but Gauss–Bonnet came 3.9e-2 → 2.7e-3 and the largest |κ| from
-/// 5.7·10⁷ to 111 times the input's, in 165 s against 248 s.
+/// 0.39°, Gauss–Bonnet 1.0e-6 (63 s and 2.4 GB against 52 s and 1.7 GB). Genus 48 reads
+/// Gauss–Bonnet 6.6e-5 at 256 (|κ| 21× the input's).
+///
+/// Above genus 48 it is 8 times the grid (384). Genus 64 at 256 read Gauss–Bonnet 2.7e-3 (issue
+/// 12 asks for 1e-3) and at 384 6.9e-4, in 174 s and 3.4 GB against 165 s and 2.4 GB (at 128
+/// 3.9e-2). Its largest |κ| stays about 110 times the input's at either grid, and a finer input
+/// mesh (10 points round each hole, 275k triangles) left both as they were (2.1e-3, 105×): the spot
+/// is where an edge chart's rim, sheared (its E_u and E_v 31° to 41° apart), blends with a disk
+/// chart whose cells span 60 to 150 model units per chart unit there, the two patches 0.03 apart.
 ///
 /// Genus 2 keeps its 32: its edge charts are the coarse ones there (a disk grid of 64 smoothed the
 /// flat faces, 0.026 → 0.013, but the patches' disagreement rose to 0.21%).
@@ -397,7 +403,8 @@ pub fn default_disk_grid(genus: u32, grid: usize) -> Option<usize> {
         0..=2 => return None,
         3..=15 => (2, 1),
         16..=31 => (8, 3),
-        _ => (16, 3),
+        32..=48 => (16, 3),
+        _ => (8, 1),
     };
     Some((grid * num).div_ceil(8 * den).max(1) * 8)
 }

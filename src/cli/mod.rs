@@ -101,10 +101,10 @@ struct FitArgs {
     grid: Option<u64>,
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
-    /// the grid from genus 3 (96 at 48), 8/3 of it from genus 16 (128) and 16/3 from genus 32
-    /// (256), the grid below genus 3; for fit twice the grid from genus 2 (80 at 40), the grid
-    /// below; the grid for fit --cage]
-    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=256))]
+    /// the grid from genus 3 (96 at 48), 8/3 of it from genus 16 (128), 16/3 from genus 32 (256)
+    /// and 8 times above genus 48 (384), the grid below genus 3; for fit twice the grid from genus
+    /// 2 (80 at 40), the grid below; the grid for fit --cage]
+    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=512))]
     disk_grid: Option<u64>,
     /// Spline degree.
     #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
