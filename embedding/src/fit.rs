@@ -1066,6 +1066,7 @@ impl Lifts {
         const OVER: f64 = 1.3;
         const MAX_STEP: f64 = 0.25;
         let anchor = self.home[self.base];
+        let adjacency = Adjacency::new(&self.neighbours);
         for sweep in 0..sweeps {
             // The largest squared move of the sweep (compared squared: `hypot` per vertex was a
             // tenth of the map's time). The torus's shift below moves every vertex: its moves are
@@ -1082,11 +1083,14 @@ impl Lifts {
                     }
                 };
                 let (mut sum, mut total) = (Complex64::ZERO, 0.0);
-                for &(w, u, g) in &self.neighbours[v] {
+                for &(w, u, g) in adjacency.of(v) {
                     let p = self.home[u as usize];
                     // Only edges across the cut carry a side pairing; the identity's image is the
                     // point itself, bit for bit, so skipping it changes nothing but the time.
-                    let p = if g == Lft::IDENTITY { p } else { g.apply(p) };
+                    let p = match g {
+                        Adjacency::IDENTITY => p,
+                        g => adjacency.pairings[g as usize].apply(p),
+                    };
                     sum += to_frame(p) * w;
                     total += w;
                 }
@@ -1214,6 +1218,47 @@ pub(crate) fn relative_stretch(surface: &[f64], model: &[f64]) -> Vec<f64> {
 
 /// What a neighbour's weight is divided by where the map stretches the surface by `stretch` there
 /// (see [`STRETCH_EXPONENT`]).
+/// [`Lifts::neighbours`] packed for the sweeps: each vertex's (weight, neighbour, pairing) in one
+/// array, the pairing an index into a table of the few that are not the identity. 16 bytes an
+/// entry against the 80 of a (weight, vertex, Lft) triple, and no pointer to follow per vertex: a
+/// sweep is memory-bound. Same sums in the same order as over `neighbours`.
+struct Adjacency {
+    start: Vec<usize>,
+    entries: Vec<(f64, u32, u32)>,
+    pairings: Vec<Lft>,
+}
+
+impl Adjacency {
+    /// The pairing index of an edge within the cut disk (no pairing).
+    const IDENTITY: u32 = u32::MAX;
+
+    fn new(neighbours: &[Vec<(f64, u32, Lft)>]) -> Adjacency {
+        let mut packed = Adjacency {
+            start: Vec::with_capacity(neighbours.len() + 1),
+            entries: Vec::with_capacity(neighbours.iter().map(Vec::len).sum()),
+            pairings: Vec::new(),
+        };
+        packed.start.push(0);
+        for list in neighbours {
+            for &(w, u, g) in list {
+                let pairing = if g == Lft::IDENTITY {
+                    Self::IDENTITY
+                } else {
+                    packed.pairings.push(g);
+                    (packed.pairings.len() - 1) as u32
+                };
+                packed.entries.push((w, u, pairing));
+            }
+            packed.start.push(packed.entries.len());
+        }
+        packed
+    }
+
+    fn of(&self, v: usize) -> &[(f64, u32, u32)] {
+        &self.entries[self.start[v]..self.start[v + 1]]
+    }
+}
+
 pub(crate) fn stretch_divisor(stretch: f64) -> f64 {
     stretch.powf(STRETCH_EXPONENT)
 }
