@@ -195,6 +195,9 @@ pub(crate) fn solve(
         let current = match factor.take() {
             Some(kept) => kept,
             None => {
+                // An earlier factorization kept for the next solve is superseded: free it first
+                // (two LUs at once would double the map's peak memory).
+                last = None;
                 report.factorizations += 1;
                 let started = std::time::Instant::now();
                 let lu = factorize(lifts, hyperbolic, &mut symbolic)?;
