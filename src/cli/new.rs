@@ -504,11 +504,14 @@ pub fn make(
 impl NewReport {
     /// How the map was solved, in words.
     fn solve_text(&self) -> String {
+        let sweeps = count(self.sweeps, "sweep", "sweeps");
         match self.newton {
             None => format!("{} relaxation sweeps", self.sweeps),
             Some(n) => format!(
-                "{} sweeps and {} Newton steps ({} factorizations, residual {:.0e})",
-                self.sweeps, n.steps, n.factorizations, n.residual
+                "{sweeps} and {} ({}, residual {:.0e})",
+                count(n.steps, "Newton step", "Newton steps"),
+                count(n.factorizations, "factorization", "factorizations"),
+                n.residual
             ),
         }
     }
@@ -590,4 +593,9 @@ impl NewReport {
             secs = self.seconds,
         )
     }
+}
+
+/// `n` and the noun that goes with it.
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }
