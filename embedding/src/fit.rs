@@ -1216,8 +1216,6 @@ pub(crate) fn relative_stretch(surface: &[f64], model: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// What a neighbour's weight is divided by where the map stretches the surface by `stretch` there
-/// (see [`STRETCH_EXPONENT`]).
 /// [`Lifts::neighbours`] packed for the sweeps: each vertex's (weight, neighbour, pairing) in one
 /// array, the pairing an index into a table of the few that are not the identity. 16 bytes an
 /// entry against the 80 of a (weight, vertex, Lft) triple, and no pointer to follow per vertex: a
@@ -1259,6 +1257,8 @@ impl Adjacency {
     }
 }
 
+/// What a neighbour's weight is divided by where the map stretches the surface by `stretch` there
+/// (see [`STRETCH_EXPONENT`]).
 pub(crate) fn stretch_divisor(stretch: f64) -> f64 {
     stretch.powf(STRETCH_EXPONENT)
 }

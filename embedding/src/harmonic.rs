@@ -13,6 +13,7 @@
 //! ‖F‖₂ so it never increases the residual, and where no decrease is found a few sweeps move the
 //! map first. The result is the same fixed point the sweeps approach.
 
+use faer::linalg::solvers::ShapeCore;
 use faer::prelude::*;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
@@ -174,7 +175,7 @@ pub(crate) fn solve(
         residual: max_norm(&f),
     };
     let (mut factor, mut symbolic) = match kept.take() {
-        Some(k) if k.vertices == lifts.home.len() => (
+        Some(k) if k.lu.nrows() == system_size(lifts.home.len(), hyperbolic) => (
             Some(Factor {
                 lu: k.lu,
                 fresh: false,
@@ -254,11 +255,7 @@ pub(crate) fn solve(
         .map(|f| f.lu)
         .or(last)
         .zip(symbolic)
-        .map(|(lu, symbolic)| KeptJacobian {
-            lu,
-            symbolic,
-            vertices: lifts.home.len(),
-        });
+        .map(|(lu, symbolic)| KeptJacobian { lu, symbolic });
     Ok(report)
 }
 
@@ -267,7 +264,12 @@ pub(crate) fn solve(
 pub(crate) struct KeptJacobian {
     lu: Lu<usize, f64>,
     symbolic: SymbolicLu<usize>,
-    vertices: usize,
+}
+
+/// The Newton system's size for `n` vertices: two real unknowns each, and on the flat torus the
+/// drift's two.
+fn system_size(n: usize, hyperbolic: bool) -> usize {
+    if hyperbolic { 2 * n } else { 2 * n + 2 }
 }
 
 /// Vertex z moved by the Newton step d. On the flat torus z + d. In the Poincaré disk the step is
@@ -331,7 +333,7 @@ fn factorize(
     symbolic: &mut Option<SymbolicLu<usize>>,
 ) -> Result<Lu<usize, f64>, EmbeddingError> {
     let n = lifts.home.len();
-    let size = if hyperbolic { 2 * n } else { 2 * n + 2 };
+    let size = system_size(n, hyperbolic);
     let a =
         SparseColMat::<usize, f64>::try_new_from_triplets(size, size, &jacobian(lifts, hyperbolic))
             .map_err(|e| failed(format!("{e:?}")))?;
@@ -351,7 +353,7 @@ fn newton_step(
     hyperbolic: bool,
     f: &[Complex64],
 ) -> Result<(Vec<Complex64>, Complex64), EmbeddingError> {
-    let size = if hyperbolic { 2 * n } else { 2 * n + 2 };
+    let size = system_size(n, hyperbolic);
     let mut rhs = Mat::<f64>::zeros(size, 1);
     for (v, c) in f.iter().enumerate() {
         rhs[(2 * v, 0)] = -c.re;
@@ -397,6 +399,15 @@ mod tests {
         )
     }
 
+    /// The largest distance between two maps' lifts of a vertex, in frame units of the first.
+    fn frame_gap(a: &Lifts, b: &Lifts) -> f64 {
+        a.home
+            .iter()
+            .zip(&b.home)
+            .map(|(a, b)| (a - b).norm() / (1.0 - a.norm_sqr()))
+            .fold(0.0, f64::max)
+    }
+
     fn copy(lifts: &Lifts) -> Lifts {
         Lifts::from_parts(
             lifts.home.clone(),
@@ -422,7 +433,7 @@ mod tests {
         for genus in 1..=5 {
             let (mut lifts, hyperbolic) = start(genus, 8);
             let n = lifts.home.len();
-            let size = if hyperbolic { 2 * n } else { 2 * n + 2 };
+            let size = system_size(n, hyperbolic);
             let a = SparseColMat::<usize, f64>::try_new_from_triplets(
                 size,
                 size,
@@ -493,12 +504,7 @@ mod tests {
                 "genus {genus}: {solved:?}"
             );
             swept.relax(hyperbolic, 200_000, 1e-13);
-            let gap = lifts
-                .home
-                .iter()
-                .zip(&swept.home)
-                .map(|(a, b)| (a - b).norm() / (1.0 - a.norm_sqr()))
-                .fold(0.0, f64::max);
+            let gap = frame_gap(&lifts, &swept);
             // On the torus the sweeps slide the map along as they go (see `jacobian`), and a
             // Gauss–Seidel sweep sees half of its neighbours already slid: their fixed point is
             // off from "F_v = c for every v" by about the slide, ~1e-5 here.
@@ -573,12 +579,7 @@ mod tests {
                 warm.factorizations < cold.factorizations,
                 "genus {genus}: kept {warm:?}, fresh {cold:?}"
             );
-            let gap = lifts
-                .home
-                .iter()
-                .zip(&fresh.home)
-                .map(|(a, b)| (a - b).norm() / (1.0 - a.norm_sqr()))
-                .fold(0.0, f64::max);
+            let gap = frame_gap(&lifts, &fresh);
             let bound = if hyperbolic { 1e-8 } else { 1e-6 };
             assert!(gap < bound, "genus {genus}: the two differ by {gap:e}");
         }

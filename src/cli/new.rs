@@ -504,11 +504,11 @@ pub fn make(
 impl NewReport {
     /// How the map was solved, in words.
     fn solve_text(&self) -> String {
-        let sweeps = count(self.sweeps, "sweep", "sweeps");
         match self.newton {
-            None => format!("{} relaxation sweeps", self.sweeps),
+            None => count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
             Some(n) => format!(
-                "{sweeps} and {} ({}, residual {:.0e})",
+                "{} and {} ({}, residual {:.0e})",
+                count(self.sweeps, "sweep", "sweeps"),
                 count(n.steps, "Newton step", "Newton steps"),
                 count(n.factorizations, "factorization", "factorizations"),
                 n.residual
