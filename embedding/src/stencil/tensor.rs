@@ -666,7 +666,7 @@ impl TensorStencil {
 mod simd {
     use std::arch::x86_64::*;
 
-    use super::{ControlFrame, PREFETCH_BLOCKS, Point3, TensorStencil, Vector3, prefetch};
+    use super::{ControlFrame, PREFETCH_BLOCKS, Point3, TensorStencil, Vector3};
 
     pub(super) fn available() -> bool {
         is_x86_feature_detected!("avx") && is_x86_feature_detected!("fma")
@@ -680,39 +680,86 @@ mod simd {
         first_row: usize,
         out: &mut [Point3],
     ) {
-        if out.is_empty() {
-            return;
-        }
+        let lines = Lines::new(stencil, frame);
         let starts = &stencil.row_starts[first_row..=first_row + out.len()];
         for (o, span) in out.iter_mut().zip(starts.windows(2)) {
-            let mut acc = _mm256_setzero_ps();
-            for k in span[0] as usize..span[1] as usize {
-                prefetch(&stencil.factors, 8 * (k + PREFETCH_BLOCKS));
-                let f: &[f32; 8] = stencil.factors[8 * k..8 * k + 8]
-                    .try_into()
-                    .expect("cubic factors");
-                // (u₀ ×4, u₁ ×4) and (u₂ ×4, u₃ ×4): the weights of two control points each.
-                let u01 = _mm256_set_m128(_mm_set1_ps(f[1]), _mm_set1_ps(f[0]));
-                let u23 = _mm256_set_m128(_mm_set1_ps(f[3]), _mm_set1_ps(f[2]));
-                let first = stencil.firsts[k] as usize;
-                let grid = stencil.grids.stride(first);
-                for (j, &v) in f[4..].iter().enumerate() {
-                    let start = first + j * grid;
-                    let line = &frame.points[start..start + 4];
-                    let p = line.as_ptr().cast::<f32>();
-                    // SAFETY: `line` is 4 Vec4s, 16 contiguous f32; the loads read floats 0–7 and
-                    // 8–15 of it.
-                    let (c01, c23) = unsafe { (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8))) };
-                    let s = _mm256_fmadd_ps(c23, u23, _mm256_mul_ps(c01, u01));
-                    acc = _mm256_fmadd_ps(s, _mm256_set1_ps(v), acc);
-                }
+            let blocks = span[0] as usize..span[1] as usize;
+            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
+            let mut acc = _mm_setzero_ps();
+            for (f, &first) in factors.zip(&stencil.firsts[blocks]) {
+                // Never faults, even past the end.
+                _mm_prefetch::<_MM_HINT_T0>(f.as_ptr().wrapping_add(8 * PREFETCH_BLOCKS).cast());
+                acc = _mm_add_ps(
+                    acc,
+                    lines.block(f.try_into().expect("cubic factors"), first as usize),
+                );
             }
-            let sum = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps::<1>(acc));
             let mut lanes = [0f32; 4];
             // SAFETY: `lanes` holds the 4 floats stored.
-            unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), sum) };
+            unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), acc) };
             let [x, y, z, _] = lanes.map(f64::from);
             *o = frame.centre + Vector3::new(x, y, z);
+        }
+    }
+
+    /// The control points as the cubic kernels read them: a block's 4 lines of 4 points each.
+    struct Lines {
+        points: *const f32,
+        /// Control points below this are the disk charts', whose lines are `disk` apart.
+        disk_points: usize,
+        disk: usize,
+        square: usize,
+    }
+
+    impl Lines {
+        fn new(stencil: &TensorStencil, frame: &ControlFrame) -> Lines {
+            let grids = stencil.grids;
+            // Every block of a built stencil lies inside the layout's grids, so with this each
+            // line's loads stay inside `frame.points`.
+            assert!(
+                frame.points.len() >= grids.count(),
+                "a control point per grid point"
+            );
+            Lines {
+                points: frame.points.as_ptr().cast(),
+                disk_points: grids.disks * grids.disk * grids.disk,
+                disk: grids.disk,
+                square: grids.square,
+            }
+        }
+
+        /// Σ_j β N_j(v) Σ_i N_i(u) c_ij of the cubic block with factors `f` whose first control
+        /// point is `first`, as (x, y, z, 0). The sums run along v first: two control points per
+        /// register, the lines' points times β N_j(v) accumulate by fused multiply-adds, and
+        /// N_i(u) multiplies once at the end.
+        #[target_feature(enable = "avx,fma")]
+        #[inline]
+        fn block(&self, f: &[f32; 8], first: usize) -> __m128 {
+            let grid = if first < self.disk_points {
+                self.disk
+            } else {
+                self.square
+            };
+            let (mut c01, mut c23) = (_mm256_setzero_ps(), _mm256_setzero_ps());
+            for (j, &v) in f[4..].iter().enumerate() {
+                // SAFETY: a block's lines lie inside the grids, which `frame.points` covers
+                // (asserted in `new`): 16 contiguous f32 from `first + j·grid`, read as floats
+                // 0–7 and 8–15.
+                let (p01, p23) = unsafe {
+                    let p = self.points.add(4 * (first + j * grid));
+                    (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8)))
+                };
+                let v = _mm256_set1_ps(v);
+                c01 = _mm256_fmadd_ps(p01, v, c01);
+                c23 = _mm256_fmadd_ps(p23, v, c23);
+            }
+            // (u₀, u₁, u₂, u₃) in both halves, spread into (u₀ ×4, u₁ ×4) and (u₂ ×4, u₃ ×4).
+            // SAFETY: `f` holds 8 floats; this reads the first 4.
+            let u = _mm256_broadcast_ps(unsafe { &*f.as_ptr().cast::<__m128>() });
+            let u01 = _mm256_permutevar_ps(u, _mm256_set_epi32(1, 1, 1, 1, 0, 0, 0, 0));
+            let u23 = _mm256_permutevar_ps(u, _mm256_set_epi32(3, 3, 3, 3, 2, 2, 2, 2));
+            let s = _mm256_fmadd_ps(c23, u23, _mm256_mul_ps(c01, u01));
+            _mm_add_ps(_mm256_castps256_ps128(s), _mm256_extractf128_ps::<1>(s))
         }
     }
 
