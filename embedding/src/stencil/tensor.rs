@@ -753,20 +753,51 @@ mod simd {
                 c01 = _mm256_fmadd_ps(p01, v, c01);
                 c23 = _mm256_fmadd_ps(p23, v, c23);
             }
-            // (u₀, u₁, u₂, u₃) in both halves, spread into (u₀ ×4, u₁ ×4) and (u₂ ×4, u₃ ×4).
-            // SAFETY: `f` holds 8 floats; this reads the first 4.
-            let u = _mm256_broadcast_ps(unsafe { &*f.as_ptr().cast::<__m128>() });
-            let u01 = _mm256_permutevar_ps(u, _mm256_set_epi32(1, 1, 1, 1, 0, 0, 0, 0));
-            let u23 = _mm256_permutevar_ps(u, _mm256_set_epi32(3, 3, 3, 3, 2, 2, 2, 2));
+            let (u01, u23) = spread(f[..4].try_into().expect("4 factors"));
             let s = _mm256_fmadd_ps(c23, u23, _mm256_mul_ps(c01, u01));
             _mm_add_ps(_mm256_castps256_ps128(s), _mm256_extractf128_ps::<1>(s))
+        }
+
+        /// A cubic block's three sums for a row with tangents (see the module's comment), each
+        /// still in two halves: A = Σ_j βN_j Σ_i N_i c_ij, B with N_i', C with βN_j'. Along v
+        /// first, as in [`Lines::block`]: the lines' points times βN_j and βN_j' accumulate,
+        /// then N_i and N_i' multiply once.
+        #[target_feature(enable = "avx,fma")]
+        #[inline]
+        fn jet_block(&self, f: &[f32; 8], d: &[f32; 12], first: usize) -> [__m256; 3] {
+            let grid = if first < self.disk_points {
+                self.disk
+            } else {
+                self.square
+            };
+            let zero = _mm256_setzero_ps();
+            let (mut v01, mut v23, mut dv01, mut dv23) = (zero, zero, zero, zero);
+            for j in 0..4 {
+                // SAFETY: as in `block`.
+                let (p01, p23) = unsafe {
+                    let p = self.points.add(4 * (first + j * grid));
+                    (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8)))
+                };
+                let (v, dv) = (_mm256_set1_ps(f[4 + j]), _mm256_set1_ps(d[4 + j]));
+                v01 = _mm256_fmadd_ps(p01, v, v01);
+                v23 = _mm256_fmadd_ps(p23, v, v23);
+                dv01 = _mm256_fmadd_ps(p01, dv, dv01);
+                dv23 = _mm256_fmadd_ps(p23, dv, dv23);
+            }
+            let (u01, u23) = spread(f[..4].try_into().expect("4 factors"));
+            let (du01, du23) = spread(d[..4].try_into().expect("4 factors"));
+            [
+                _mm256_fmadd_ps(v23, u23, _mm256_mul_ps(v01, u01)),
+                _mm256_fmadd_ps(v23, du23, _mm256_mul_ps(v01, du01)),
+                _mm256_fmadd_ps(dv23, u23, _mm256_mul_ps(dv01, u01)),
+            ]
         }
     }
 
     /// Positions and tangents of rows `first_row..first_row + positions.len()` of a cubic stencil
     /// built with tangents: the portable tangent kernel's sums, two control points per 256-bit
-    /// register. Every step after the first products is linear with the same factor in both
-    /// halves, so the halves are added only at the row's end.
+    /// register, along v first as in [`cubic_rows`]. Every step after the first products is
+    /// linear with the same factor in both halves, so the halves are added only at the row's end.
     #[target_feature(enable = "avx,fma")]
     pub(super) fn cubic_jets(
         stencil: &TensorStencil,
@@ -775,47 +806,22 @@ mod simd {
         positions: &mut [Point3],
         tangents: &mut [[Vector3; 2]],
     ) {
-        if positions.is_empty() {
-            return;
-        }
-        let pair = |a: f32, b: f32| _mm256_set_m128(_mm_set1_ps(b), _mm_set1_ps(a));
+        let lines = Lines::new(stencil, frame);
         let starts = &stencil.row_starts[first_row..=first_row + positions.len()];
         for ((o, t), span) in positions.iter_mut().zip(tangents).zip(starts.windows(2)) {
+            let blocks = span[0] as usize..span[1] as usize;
+            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
+            let derivatives =
+                stencil.tangent_factors[12 * blocks.start..12 * blocks.end].chunks_exact(12);
             let (mut p, mut su, mut sv) = (
                 _mm256_setzero_ps(),
                 _mm256_setzero_ps(),
                 _mm256_setzero_ps(),
             );
-            for k in span[0] as usize..span[1] as usize {
-                let f: &[f32; 8] = stencil.factors[8 * k..8 * k + 8]
-                    .try_into()
-                    .expect("cubic factors");
-                let d: &[f32; 12] = stencil.tangent_factors[12 * k..12 * k + 12]
-                    .try_into()
-                    .expect("cubic tangent factors");
-                let (u01, u23) = (pair(f[0], f[1]), pair(f[2], f[3]));
-                let (du01, du23) = (pair(d[0], d[1]), pair(d[2], d[3]));
-                let first = stencil.firsts[k] as usize;
-                let grid = stencil.grids.stride(first);
-                let (mut a, mut b, mut c) = (
-                    _mm256_setzero_ps(),
-                    _mm256_setzero_ps(),
-                    _mm256_setzero_ps(),
-                );
-                for j in 0..4 {
-                    let start = first + j * grid;
-                    let line = &frame.points[start..start + 4];
-                    let ptr = line.as_ptr().cast::<f32>();
-                    // SAFETY: `line` is 4 Vec4s, 16 contiguous f32; the loads read floats 0–7 and
-                    // 8–15 of it.
-                    let (c01, c23) = unsafe { (_mm256_loadu_ps(ptr), _mm256_loadu_ps(ptr.add(8))) };
-                    let s = _mm256_fmadd_ps(c23, u23, _mm256_mul_ps(c01, u01));
-                    let s1 = _mm256_fmadd_ps(c23, du23, _mm256_mul_ps(c01, du01));
-                    let (v, dv) = (_mm256_set1_ps(f[4 + j]), _mm256_set1_ps(d[4 + j]));
-                    a = _mm256_fmadd_ps(s, v, a);
-                    b = _mm256_fmadd_ps(s1, v, b);
-                    c = _mm256_fmadd_ps(s, dv, c);
-                }
+            for ((f, d), &first) in factors.zip(derivatives).zip(&stencil.firsts[blocks]) {
+                let d: &[f32; 12] = d.try_into().expect("cubic tangent factors");
+                let [a, b, c] =
+                    lines.jet_block(f.try_into().expect("cubic factors"), d, first as usize);
                 let (gu, gv) = (_mm256_set1_ps(d[8]), _mm256_set1_ps(d[9]));
                 let (re, im) = (_mm256_set1_ps(d[10]), _mm256_set1_ps(d[11]));
                 p = _mm256_add_ps(p, a);
@@ -837,6 +843,19 @@ mod simd {
             *o = frame.centre + wide(p);
             *t = [wide(su), wide(sv)];
         }
+    }
+
+    /// Spreads (u₀, u₁, u₂, u₃) into (u₀ ×4, u₁ ×4) and (u₂ ×4, u₃ ×4): each control point's
+    /// factor in a register that holds two of them.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn spread(u: &[f32; 4]) -> (__m256, __m256) {
+        // SAFETY: `u` holds the 4 floats read.
+        let u = _mm256_broadcast_ps(unsafe { &*u.as_ptr().cast::<__m128>() });
+        (
+            _mm256_permutevar_ps(u, _mm256_set_epi32(1, 1, 1, 1, 0, 0, 0, 0)),
+            _mm256_permutevar_ps(u, _mm256_set_epi32(3, 3, 3, 3, 2, 2, 2, 2)),
+        )
     }
 }
 
