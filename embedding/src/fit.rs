@@ -68,6 +68,9 @@ pub struct Parameterization {
     pub folded: usize,
     /// Gauss–Seidel sweeps run: before Newton's method, or for the sphere the whole relaxation.
     pub sweeps: usize,
+    /// Rounds of evening the sphere's map out in the plane, where they were taken (genus 0's
+    /// long limbs); 0 elsewhere.
+    pub evened: usize,
     /// Newton's solve of the map, over every reweighting round (`None` for the sphere, whose map is
     /// relaxed by sweeps alone).
     pub newton: Option<Convergence>,
@@ -787,6 +790,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
         copies: Vec::new(),
         folded: 0,
         sweeps: 0,
+        evened: 0,
         newton: None,
         map_distortion: None,
     }
@@ -847,6 +851,7 @@ fn flatten(
         copies,
         folded,
         sweeps: solved.sweeps,
+        evened: 0,
         newton: Some(solved),
         map_distortion: None,
     })

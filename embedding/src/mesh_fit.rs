@@ -289,6 +289,7 @@ fn finish(
             copies: Vec::new(),
             folded: mapped.folded,
             sweeps: mapped.sweeps,
+            evened: mapped.evened,
             newton: mapped.solved,
             map_distortion: mapped.distortion,
         },
@@ -307,6 +308,8 @@ struct Mapped {
     lifts: Vec<Complex64>,
     folded: usize,
     sweeps: usize,
+    /// Rounds of evening the sphere's map out in the plane (0 elsewhere).
+    evened: usize,
     /// Newton's solve of the polygon's map (none for the sphere's).
     solved: Option<Convergence>,
     /// The map's distortion (the polygon's or the sphere's).
@@ -341,6 +344,7 @@ fn map_to_sphere(
         lifts: Vec::new(),
         folded: map.folded,
         sweeps: map.sweeps,
+        evened: map.evened,
         solved: None,
         distortion: map.distortion,
         loops: LoopReport {
@@ -412,6 +416,7 @@ fn map_to_polygon(
         lifts: lifts.home,
         folded,
         sweeps,
+        evened: 0,
         solved: Some(solved),
         distortion,
         loops,

@@ -241,21 +241,25 @@ proptest! {
 
 /// Genus 0 with long thin limbs, meshed by marching tetrahedra (needles and high valences, as scans
 /// have): the conformal map squeezes the legs' ends to specks of the sphere, where the relaxation's
-/// sweeps crawl, and on its own it folded triangles there (as on real meshes: a cow, a bone, an
-/// airplane). The map is a Tutte map on the punctured sphere, and a relaxation round that would
-/// fold anything is dropped, so it stays a bijection.
+/// sweeps crawl, and on their own they folded triangles there (as on real meshes: a cow, a bone, an
+/// airplane). So the sweeps' rounds are dropped where they would fold, and the map is evened out in
+/// the plane instead (`sphere_map::even_out`): a bijection, and the fit through it (the library's
+/// grid of 32) much closer to the vertices. Measured at cells 0.1 and 0.07: areas ×2.73 and ×1.72
+/// on average, the largest residual 5.5% and 2.0% of the diagonal; with the sweeps' map alone
+/// ×43 and ×55, 14.6% and 13.4%.
 #[test]
 fn a_genus_zero_animal_with_thin_legs_maps_without_a_fold() {
-    for cell in [0.1, 0.07] {
+    for (cell, most) in [(0.1, 0.07), (0.07, 0.03)] {
         let (positions, triangles) = shapes::animal(cell);
         let fit = default_fit(&positions, &triangles);
+        let map = &fit.parameterization;
+        let area = map.map_distortion.expect("measured").area_mean;
+        let residual = fit.max_residual / fit.mesh_diagonal;
         assert_eq!(fit.genus, 0);
-        assert_eq!(
-            fit.parameterization.folded,
-            0,
-            "cell {cell}: {} triangles",
-            triangles.len()
-        );
+        assert_eq!(map.folded, 0, "cell {cell}: {} triangles", triangles.len());
+        assert!(map.evened > 0, "cell {cell}");
+        assert!(area <= 3.0, "cell {cell}: areas ×{area}");
+        assert!(residual <= most, "cell {cell}: residual {residual}");
     }
 }
 

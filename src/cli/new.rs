@@ -194,6 +194,8 @@ pub struct NewReport {
     /// map's warm-up), Newton's solve of the polygon's map, and triangles the map folds (0: a
     /// bijection).
     pub sweeps: usize,
+    /// Rounds of evening the sphere's map out in the plane, where they were taken.
+    pub evened: usize,
     pub newton: Option<embedding::harmonic::Convergence>,
     /// How far the map onto the polygon is from conformal and area-preserving (plates only: it is
     /// measured on their cut disk).
@@ -433,6 +435,7 @@ pub fn check(
         mesh_triangles: triangles.len(),
         control_points: surface.control_points().len(),
         sweeps: parameterization.sweeps,
+        evened: parameterization.evened,
         newton: parameterization.newton,
         distortion: parameterization.distortion(positions, surface.atlas().geometry()),
         folded_triangles: parameterization.folded,
@@ -505,6 +508,11 @@ impl NewReport {
     /// How the map was solved, in words.
     fn solve_text(&self) -> String {
         match self.newton {
+            None if self.evened > 0 => format!(
+                "{}, then {} in the plane",
+                count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
+                count(self.evened, "round evened out", "rounds evened out")
+            ),
             None => count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
             Some(n) => format!(
                 "{} and {} ({}, residual {:.0e})",
