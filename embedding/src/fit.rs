@@ -68,11 +68,11 @@ pub struct Parameterization {
     pub folded: usize,
     /// Gauss–Seidel sweeps run: before Newton's method, or for the sphere the whole relaxation.
     pub sweeps: usize,
-    /// Rounds of evening the sphere's map out in the plane, where they were taken (genus 0's
-    /// long limbs); 0 elsewhere.
-    pub evened: usize,
+    /// Rounds of the sphere's map solved in the plane to even its area out, where they were taken
+    /// (genus 0's long limbs; not the evening of a mesh of thin triangles); 0 elsewhere.
+    pub planar_rounds: usize,
     /// Newton's solve of the map, over every reweighting round (`None` for the sphere, whose map is
-    /// relaxed by sweeps alone).
+    /// relaxed by sweeps, or solved in the plane in its planar rounds).
     pub newton: Option<Convergence>,
     /// The map's distortion where there is no cut disk to measure it on (a user's mesh, mapped
     /// closed: each triangle in the frame its corners were solved in, or on the sphere against its
@@ -790,7 +790,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
         copies: Vec::new(),
         folded: 0,
         sweeps: 0,
-        evened: 0,
+        planar_rounds: 0,
         newton: None,
         map_distortion: None,
     }
@@ -851,7 +851,7 @@ fn flatten(
         copies,
         folded,
         sweeps: solved.sweeps,
-        evened: 0,
+        planar_rounds: 0,
         newton: Some(solved),
         map_distortion: None,
     })

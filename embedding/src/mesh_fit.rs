@@ -289,7 +289,7 @@ fn finish(
             copies: Vec::new(),
             folded: mapped.folded,
             sweeps: mapped.sweeps,
-            evened: mapped.evened,
+            planar_rounds: mapped.planar_rounds,
             newton: mapped.solved,
             map_distortion: mapped.distortion,
         },
@@ -308,8 +308,8 @@ struct Mapped {
     lifts: Vec<Complex64>,
     folded: usize,
     sweeps: usize,
-    /// Rounds of evening the sphere's map out in the plane (0 elsewhere).
-    evened: usize,
+    /// Rounds of the sphere's map solved in the plane (0 elsewhere).
+    planar_rounds: usize,
     /// Newton's solve of the polygon's map (none for the sphere's).
     solved: Option<Convergence>,
     /// The map's distortion (the polygon's or the sphere's).
@@ -344,7 +344,7 @@ fn map_to_sphere(
         lifts: Vec::new(),
         folded: map.folded,
         sweeps: map.sweeps,
-        evened: map.evened,
+        planar_rounds: map.planar_rounds,
         solved: None,
         distortion: map.distortion,
         loops: LoopReport {
@@ -416,7 +416,7 @@ fn map_to_polygon(
         lifts: lifts.home,
         folded,
         sweeps,
-        evened: 0,
+        planar_rounds: 0,
         solved: Some(solved),
         distortion,
         loops,

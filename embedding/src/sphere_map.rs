@@ -56,7 +56,7 @@ pub(crate) struct SphereMap {
     /// Relaxation sweeps run in all rounds.
     pub sweeps: usize,
     /// Rounds of [`even_out`] whose map was taken (0: the sweeps' map was kept).
-    pub evened: usize,
+    pub planar_rounds: usize,
     /// How far from conformal and from area-preserving the map is.
     pub distortion: Option<Distortion>,
 }
@@ -152,7 +152,7 @@ pub(crate) fn sphere_map(
         points,
         folded,
         sweeps: used,
-        evened,
+        planar_rounds: evened,
     })
 }
 

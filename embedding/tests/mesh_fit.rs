@@ -257,7 +257,7 @@ fn a_genus_zero_animal_with_thin_legs_maps_without_a_fold() {
         let residual = fit.max_residual / fit.mesh_diagonal;
         assert_eq!(fit.genus, 0);
         assert_eq!(map.folded, 0, "cell {cell}: {} triangles", triangles.len());
-        assert!(map.evened > 0, "cell {cell}");
+        assert!(map.planar_rounds > 0, "cell {cell}");
         assert!(area <= 3.0, "cell {cell}: areas ×{area}");
         assert!(residual <= most, "cell {cell}: residual {residual}");
     }

@@ -30,7 +30,8 @@ use super::{FitArgs, FitProgress};
 /// the triangles' directions; the fit's data stay the mesh's own vertices, and the map whose fit
 /// comes closer to them is kept. If a check
 /// fails, no model is written (unless --keep-failed) and the exit status is 3. A genus-0 mesh is
-/// mapped onto the sphere instead (no loops).
+/// mapped onto the sphere instead (no loops); where the relaxation there leaves long limbs
+/// squeezed, the map is made again in rounds of planar solves that even its area out.
 ///
 /// Examples:
 ///   ntori fit assets/meshes/pretzel.obj -o pretzel.json

@@ -194,8 +194,8 @@ pub struct NewReport {
     /// map's warm-up), Newton's solve of the polygon's map, and triangles the map folds (0: a
     /// bijection).
     pub sweeps: usize,
-    /// Rounds of evening the sphere's map out in the plane, where they were taken.
-    pub evened: usize,
+    /// Rounds of the sphere's map solved in the plane to even its area out, where taken.
+    pub planar_rounds: usize,
     pub newton: Option<embedding::harmonic::Convergence>,
     /// How far the map onto the polygon is from conformal and area-preserving (plates only: it is
     /// measured on their cut disk).
@@ -435,7 +435,7 @@ pub fn check(
         mesh_triangles: triangles.len(),
         control_points: surface.control_points().len(),
         sweeps: parameterization.sweeps,
-        evened: parameterization.evened,
+        planar_rounds: parameterization.planar_rounds,
         newton: parameterization.newton,
         distortion: parameterization.distortion(positions, surface.atlas().geometry()),
         folded_triangles: parameterization.folded,
@@ -508,10 +508,10 @@ impl NewReport {
     /// How the map was solved, in words.
     fn solve_text(&self) -> String {
         match self.newton {
-            None if self.evened > 0 => format!(
-                "{}, then {} in the plane",
+            None if self.planar_rounds > 0 => format!(
+                "{}, then {}",
                 count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
-                count(self.evened, "round evened out", "rounds evened out")
+                count(self.planar_rounds, "planar round", "planar rounds")
             ),
             None => count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
             Some(n) => format!(

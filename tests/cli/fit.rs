@@ -430,9 +430,9 @@ fn real_genus_zero_meshes_with_long_limbs_are_evened_out_and_fit_without_a_fold(
         assert_eq!(fit["genus"], 0, "{name}");
         assert_eq!(fit["folded_triangles"], 0, "{name}");
         assert!(
-            fit["evened"].as_u64().unwrap() > 0,
+            fit["planar_rounds"].as_u64().unwrap() > 0,
             "{name}: {}",
-            fit["evened"]
+            fit["planar_rounds"]
         );
         let distance = fit["shape"]["distance_to_input"].as_f64().unwrap();
         assert!(distance <= most, "{name}: {distance}");

@@ -353,7 +353,7 @@ fn distortion_measures_known_maps() {
         copies: plane.iter().map(|p| f(p.x, p.y)).collect(),
         folded: 0,
         sweeps: 0,
-        evened: 0,
+        planar_rounds: 0,
         newton: None,
         map_distortion: None,
     };
