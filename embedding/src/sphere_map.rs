@@ -288,7 +288,7 @@ fn untangle(
         let before: Vec<Vector3<f64>> = set.iter().map(|&v| points[v]).collect();
         for _ in 0..UNTANGLE_SWEEPS {
             for &v in &set {
-                if let Some(d) = mean_value_step(points, &neighbours[v], points[v]) {
+                if let Some(d) = mean_value_step(points, &neighbours[v], points[v], 1.0) {
                     points[v] = from_frame(points[v], d);
                 }
             }
@@ -303,12 +303,13 @@ fn untangle(
     folded
 }
 
-/// The step in x's frame to the weighted mean of its neighbours, capped at the sweeps' step
-/// (None for a vertex without weight).
+/// The step in x's frame to the weighted mean of its neighbours, times `over` (over-relaxation),
+/// capped at [`MAX_STEP`] (None for a vertex without weight).
 fn mean_value_step(
     points: &[Vector3<f64>],
     neighbours: &[(f64, u32)],
     x: Vector3<f64>,
+    over: f64,
 ) -> Option<Vector3<f64>> {
     let (mut sum, mut total) = (Vector3::zeros(), 0.0);
     for &(w, u) in neighbours {
@@ -316,7 +317,7 @@ fn mean_value_step(
         total += w;
     }
     (total > 0.0).then(|| {
-        let d = sum / total;
+        let d = sum / total * over;
         if d.norm() > MAX_STEP {
             d * (MAX_STEP / d.norm())
         } else {
@@ -509,20 +510,9 @@ fn relax(
     for sweep in 0..sweeps {
         let before = points.to_vec();
         for v in 0..points.len() {
-            let x = points[v];
-            let (mut sum, mut total) = (Vector3::zeros(), 0.0);
-            for &(w, u) in &neighbours[v] {
-                sum += to_frame(x, points[u as usize]) * w;
-                total += w;
+            if let Some(d) = mean_value_step(points, &neighbours[v], points[v], OVER) {
+                points[v] = from_frame(points[v], d);
             }
-            if total <= 0.0 {
-                continue;
-            }
-            let mut d = sum / total * OVER;
-            if d.norm() > MAX_STEP {
-                d *= MAX_STEP / d.norm();
-            }
-            points[v] = from_frame(x, d);
         }
         centre(points, areas);
         let moved = points

@@ -728,6 +728,28 @@ mod simd {
             }
         }
 
+        /// The 4 lines of the block whose first control point is `first`, each as points 0–1 and
+        /// 2–3 of the line, (x, y, z, 0) twice per register. The lines are the chart's grid apart
+        /// (`ControlGrids::stride`, its bound hoisted into `disk_points`).
+        #[target_feature(enable = "avx")]
+        #[inline]
+        fn lines(&self, first: usize) -> [(__m256, __m256); 4] {
+            let grid = if first < self.disk_points {
+                self.disk
+            } else {
+                self.square
+            };
+            std::array::from_fn(|j| {
+                // SAFETY: a block's lines lie inside the grids, which `frame.points` covers
+                // (asserted in `new`): 16 contiguous f32 from `first + j·grid`, read as floats
+                // 0–7 and 8–15.
+                unsafe {
+                    let p = self.points.add(4 * (first + j * grid));
+                    (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8)))
+                }
+            })
+        }
+
         /// Σ_j β N_j(v) Σ_i N_i(u) c_ij of the cubic block with factors `f` whose first control
         /// point is `first`, as (x, y, z, 0). The sums run along v first: two control points per
         /// register, the lines' points times β N_j(v) accumulate by fused multiply-adds, and
@@ -735,20 +757,8 @@ mod simd {
         #[target_feature(enable = "avx,fma")]
         #[inline]
         fn block(&self, f: &[f32; 8], first: usize) -> __m128 {
-            let grid = if first < self.disk_points {
-                self.disk
-            } else {
-                self.square
-            };
             let (mut c01, mut c23) = (_mm256_setzero_ps(), _mm256_setzero_ps());
-            for (j, &v) in f[4..].iter().enumerate() {
-                // SAFETY: a block's lines lie inside the grids, which `frame.points` covers
-                // (asserted in `new`): 16 contiguous f32 from `first + j·grid`, read as floats
-                // 0–7 and 8–15.
-                let (p01, p23) = unsafe {
-                    let p = self.points.add(4 * (first + j * grid));
-                    (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8)))
-                };
+            for ((p01, p23), &v) in self.lines(first).into_iter().zip(&f[4..]) {
                 let v = _mm256_set1_ps(v);
                 c01 = _mm256_fmadd_ps(p01, v, c01);
                 c23 = _mm256_fmadd_ps(p23, v, c23);
@@ -765,19 +775,9 @@ mod simd {
         #[target_feature(enable = "avx,fma")]
         #[inline]
         fn jet_block(&self, f: &[f32; 8], d: &[f32; 12], first: usize) -> [__m256; 3] {
-            let grid = if first < self.disk_points {
-                self.disk
-            } else {
-                self.square
-            };
             let zero = _mm256_setzero_ps();
             let (mut v01, mut v23, mut dv01, mut dv23) = (zero, zero, zero, zero);
-            for j in 0..4 {
-                // SAFETY: as in `block`.
-                let (p01, p23) = unsafe {
-                    let p = self.points.add(4 * (first + j * grid));
-                    (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8)))
-                };
+            for (j, (p01, p23)) in self.lines(first).into_iter().enumerate() {
                 let (v, dv) = (_mm256_set1_ps(f[4 + j]), _mm256_set1_ps(d[4 + j]));
                 v01 = _mm256_fmadd_ps(p01, v, v01);
                 v23 = _mm256_fmadd_ps(p23, v, v23);
