@@ -231,6 +231,10 @@ pub struct FitSettings {
     /// is made ([`crate::mesh_fit::mesh_model`], genus ≥ 1; 0: the map follows the mesh's own
     /// triangles). The plates are even already and ignore it.
     pub even_rounds: usize,
+    /// Measure the smoothness term in the surface's own arc length ([`crate::bending`]): the fit is
+    /// solved twice, the second time with the first's metric. For maps that stretch the surface
+    /// more one way than the other (a user's tubes and limbs); `new`'s plates keep the grids' term.
+    pub surface_smoothness: bool,
 }
 
 impl Default for FitSettings {
@@ -241,6 +245,7 @@ impl Default for FitSettings {
             stretch_rounds: 1,
             sweeps: 5000,
             even_rounds: crate::mesh_fit::EVEN_ROUNDS,
+            surface_smoothness: false,
         }
     }
 }
@@ -1430,16 +1435,7 @@ pub fn fit(
             }
         }
     }
-    let smooth = smoothness_rows(layout);
-    let reg_rows = smooth.len();
-    let root = (settings.smoothness * points.len() as f64 / reg_rows as f64).sqrt();
-    for (k, row) in smooth.iter().enumerate() {
-        for &(c, v) in row {
-            triplets.push(Triplet::new(data_rows + k, c, root * v));
-        }
-    }
-    let (rows, cols) = (data_rows + reg_rows, layout.control_count());
-    let mut rhs = Mat::<f64>::zeros(rows, 3);
+    let mut rhs = Mat::<f64>::zeros(data_rows, 3);
     for (r, t) in targets.iter().enumerate() {
         let scale = (weights[r] / mean_weight).sqrt();
         for d in 0..3 {
@@ -1451,6 +1447,50 @@ pub fn fit(
             rhs[(points.len() + k, d)] = scale * t[d];
         }
     }
+    let data = DataRows {
+        triplets,
+        rhs,
+        points: points.len(),
+    };
+    let control = solve_with(layout, &data, &smoothness_rows(layout), settings.smoothness)?;
+    if !settings.surface_smoothness {
+        return Ok(control);
+    }
+    let bending = crate::bending::arc_length_rows(layout, &control);
+    solve_with(layout, &data, &bending, settings.smoothness)
+}
+
+/// The fit's data rows (the points and the patch terms): A's entries and the right-hand sides.
+struct DataRows {
+    triplets: Vec<Triplet<usize, usize, f64>>,
+    rhs: Mat<f64>,
+    /// The surface points fitted (N, which the smoothness weight is relative to).
+    points: usize,
+}
+
+/// The control points fitting `data` with the smoothness rows `smooth` at weight λ
+/// (`smoothness`): λ (N / R) ‖D c‖² for N points and R rows.
+fn solve_with(
+    layout: &Layout,
+    data: &DataRows,
+    smooth: &[Vec<(usize, f64)>],
+    smoothness: f64,
+) -> Result<Vec<Point3>, EmbeddingError> {
+    let data_rows = data.rhs.nrows();
+    let root = (smoothness * data.points as f64 / smooth.len() as f64).sqrt();
+    let mut triplets = data.triplets.clone();
+    for (k, row) in smooth.iter().enumerate() {
+        for &(c, v) in row {
+            triplets.push(Triplet::new(data_rows + k, c, root * v));
+        }
+    }
+    let (rows, cols) = (data_rows + smooth.len(), layout.control_count());
+    let mut rhs = Mat::<f64>::zeros(rows, 3);
+    for r in 0..data_rows {
+        for d in 0..3 {
+            rhs[(r, d)] = data.rhs[(r, d)];
+        }
+    }
     let x = least_squares(rows, cols, &triplets, &rhs)?;
     let control: Vec<Point3> = (0..cols)
         .map(|c| Point3::new(x[(c, 0)], x[(c, 1)], x[(c, 2)]))
@@ -1459,8 +1499,7 @@ pub fn fit(
         // Not `Unsolvable` (that is the edit's): say what of the fit's input can cause it.
         return Err(EmbeddingError::Parameterization(format!(
             "the least-squares fit gave control points that are not finite numbers \
-             (smoothness weight {}: far too large or too small for the data?)",
-            settings.smoothness
+             (smoothness weight {smoothness}: far too large or too small for the data?)"
         )));
     }
     Ok(control)

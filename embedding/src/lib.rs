@@ -21,6 +21,7 @@
 //!
 //! This crate builds on [`charts`]; it knows nothing of files, windows or GPUs.
 
+mod bending;
 pub mod brush;
 pub mod bspline;
 pub mod edit;

@@ -113,6 +113,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         })
     };
     fit.even_rounds = args.even_rounds as usize;
+    fit.surface_smoothness = embedding::mesh_fit::surface_smoothness(valid.genus);
     let progress = FitProgress::new(args.quiet);
     let fitted = mesh_model(
         &valid.positions,
