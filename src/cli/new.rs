@@ -247,14 +247,19 @@ pub struct ShapeReport {
     pub self_intersections: usize,
     pub intersection_samples: u32,
     pub coarse_crossings: usize,
-    /// The two-sided Hausdorff distance between the surface's t_e = t_r = [`DISTANCE_SAMPLES`]
+    /// The two-sided Hausdorff distance between the surface's t_e = t_r = `distance_samples`
     /// tessellation and the input mesh, as a fraction of the diagonal: how far apart they are
     /// anywhere, where the residual sees only the mesh's vertices. Reported, not gated.
     pub distance_to_input: f64,
+    /// [`DISTANCE_SAMPLES`], or finer up to [`FINEST_DISTANCE_SAMPLES`] where its edges are longer
+    /// than the input's ([`embedding::quality::distance_resolution`]).
+    pub distance_samples: u32,
 }
 
-/// The tessellation (t_e = t_r) the distance to the input is measured from.
+/// The coarsest tessellation (t_e = t_r) the distance to the input is measured from.
 pub const DISTANCE_SAMPLES: u32 = 32;
+/// The finest: 128 (genus 1: 163 000 vertices).
+pub const FINEST_DISTANCE_SAMPLES: u32 = 128;
 
 /// The tessellation the shape measures sample (t_e = t_r).
 const SHAPE_SAMPLES: u32 = 16;
@@ -291,9 +296,16 @@ fn measure_shape(
     };
     let normals = quality::normal_deviation_from(surface, at, reference);
     stage("measuring the distance to the input");
+    let distance_samples = quality::distance_resolution(
+        surface,
+        fitted.positions,
+        fitted.triangles,
+        DISTANCE_SAMPLES,
+        FINEST_DISTANCE_SAMPLES,
+    )?;
     let distance = quality::hausdorff_to_mesh(
         surface,
-        DISTANCE_SAMPLES,
+        distance_samples,
         fitted.positions,
         fitted.triangles,
     )?;
@@ -315,6 +327,7 @@ fn measure_shape(
         intersection_samples: last.0,
         coarse_crossings: if crossings.len() > 1 { first.1 } else { 0 },
         distance_to_input: distance.symmetric / diagonal,
+        distance_samples,
     })
 }
 
@@ -567,7 +580,7 @@ impl NewReport {
             max = 100.0 * self.max_residual,
             res = verdict(self.max_residual <= RESIDUAL_TOLERANCE),
             dist = 100.0 * self.shape.distance_to_input,
-            dist_t = DISTANCE_SAMPLES,
+            dist_t = self.shape.distance_samples,
             k = self.total_curvature,
             e = self.expected_curvature,
             gb = self.curvature_error,
