@@ -114,7 +114,8 @@ struct FitArgs {
     #[arg(long, default_value_t = SplineSettings::default().continuity as u64, value_name = "K",
           value_parser = clap::value_parser!(u64).range(1..=4))]
     continuity: u64,
-    /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term)
+    /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term;
+    /// `fit` from genus 1 measures that energy in the surface's arc length, from a first fit)
     /// [default: 1e-4 for grids up to 32, 2e-3 for finer ones, whose second differences are
     /// smaller for the same shape]
     #[arg(long, value_name = "λ", value_parser = parse_smoothness)]
