@@ -231,7 +231,7 @@ pub struct FitSettings {
     /// is made ([`crate::mesh_fit::mesh_model`], genus ≥ 1; 0: the map follows the mesh's own
     /// triangles). The plates are even already and ignore it.
     pub even_rounds: usize,
-    /// Measure the smoothness term in the surface's own arc length ([`crate::bending`]): the fit is
+    /// Measure the smoothness term in the surface's own arc length (`bending.rs`): the fit is
     /// solved twice, the second time with the first's metric. For maps that stretch the surface
     /// more one way than the other (a user's tubes and limbs); `new`'s plates keep the grids' term.
     pub surface_smoothness: bool,

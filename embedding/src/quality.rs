@@ -353,7 +353,7 @@ pub fn distance_resolution(
 
 /// The most vertices [`distance_resolution`] lets the tessellation have (genus 1 at 128 has
 /// 163 000; a plate of genus 10 at 64, 230 000, stays at 32).
-const DISTANCE_VERTEX_BUDGET: f64 = 200_000.0;
+pub const DISTANCE_VERTEX_BUDGET: f64 = 200_000.0;
 
 /// The `q` quantile of `values` (sorted in place), or `None` for none.
 fn percentile(values: &mut [f64], q: f64) -> Option<f64> {
