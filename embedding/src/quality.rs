@@ -154,16 +154,13 @@ pub struct AngleSpread {
 
 impl AngleSpread {
     fn of(mut angles: Vec<f64>) -> AngleSpread {
-        if angles.is_empty() {
-            return AngleSpread::default();
-        }
         angles.sort_by(f64::total_cmp);
-        let at = |q: f64| angles[((angles.len() - 1) as f64 * q).round() as usize];
+        let at = |q: f64| sorted_quantile(&angles, q).unwrap_or_default();
         AngleSpread {
             median: at(0.5),
             p90: at(0.9),
             p95: at(0.95),
-            max: angles[angles.len() - 1],
+            max: at(1.0),
         }
     }
 }
@@ -307,59 +304,77 @@ pub fn hausdorff_to_mesh(
     Ok(mesh::spatial::hausdorff(a, b)?)
 }
 
-/// The tessellation (t_e = t_r, from `coarsest` doubling up to `finest`) fine enough to measure the
-/// surface's distance from a mesh by: its edges (95th percentile) no longer than the mesh's median
-/// edge. A coarser one measures its own chords: a map that stretches the surface one way (a tube
-/// 12 times longer than round on the square torus) gives the tessellation edges 12 times longer
-/// along the tube than round it. CGAL's `knot.off` fitted read 0.99% at 32, 0.53% at 64 and 0.445%
-/// at 128 (its 95th-percentile edge 0.035, 0.0176: the mesh's median is 0.036), against 0.43% on a
-/// tessellation to 0.1% of the diagonal. Edges halve as t doubles, so only `coarsest` is made;
-/// finer ones stop within [`DISTANCE_VERTEX_BUDGET`] vertices.
-pub fn distance_resolution(
+/// [`hausdorff_to_mesh`] on a tessellation fine enough to measure the surface by (t_e = t_r from
+/// `coarsest`, doubling up to `finest`): its edges (95th percentile) no longer than the mesh's
+/// median edge. Returns the distance and the t it was measured at. A coarser tessellation measures
+/// its own chords: a map that stretches the surface one way (a tube 12 times longer than round on
+/// the square torus) gives the tessellation edges 12 times longer along the tube than round it.
+/// CGAL's `knot.off` fitted read 0.99% at 32, 0.53% at 64 and 0.445% at 128 (its 95th-percentile
+/// edge 0.035, 0.0176: the mesh's median is 0.036), against 0.43% on a tessellation to 0.1% of
+/// the diagonal. Edges halve as t doubles, so the choice is made on the coarsest alone; finer
+/// ones stop within [`DISTANCE_VERTEX_BUDGET`] vertices.
+pub fn hausdorff_to_mesh_resolved(
     surface: &Surface,
     positions: &[Point3],
     triangles: &[[u32; 3]],
     coarsest: u32,
     finest: u32,
-) -> Result<u32, EmbeddingError> {
-    let (tess_positions, tess_triangles) = tessellated(surface, coarsest)?;
-    let edge = |p: [f64; 3], q: [f64; 3]| Point3::from(p) - Point3::from(q);
-    let mut tess_edges: Vec<f64> = tess_triangles
-        .iter()
-        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-        .map(|(a, b)| edge(tess_positions[a as usize], tess_positions[b as usize]).norm())
-        .collect();
-    let mut mesh_edges: Vec<f64> = triangles
-        .iter()
-        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-        .map(|(a, b)| (positions[a as usize] - positions[b as usize]).norm())
-        .collect();
-    let (Some(mut longest), Some(median)) = (
-        percentile(&mut tess_edges, 0.95),
-        percentile(&mut mesh_edges, 0.5),
-    ) else {
-        return Ok(coarsest);
-    };
-    // The tessellation's vertices grow as t²: stop short of DISTANCE_VERTEX_BUDGET.
+) -> Result<(mesh::spatial::Hausdorff, u32), EmbeddingError> {
+    let coarse = tessellated(surface, coarsest)?;
+    let input: Vec<[f64; 3]> = positions.iter().map(|p| p.coords.into()).collect();
     let mut t = coarsest;
-    let vertices_at =
-        |t: u32| tess_positions.len() as f64 * (f64::from(t) / f64::from(coarsest)).powi(2);
-    while t < finest && longest > median && vertices_at(2 * t) <= DISTANCE_VERTEX_BUDGET {
-        t *= 2;
-        longest /= 2.0;
+    if let (Some(mut longest), Some(median)) = (
+        quantile(edge_lengths(&coarse.0, &coarse.1), 0.95),
+        quantile(edge_lengths(&input, triangles), 0.5),
+    ) {
+        // The tessellation's vertices grow as t².
+        let vertices_at =
+            |t: u32| coarse.0.len() as f64 * (f64::from(t) / f64::from(coarsest)).powi(2);
+        while t < finest && longest > median && vertices_at(2 * t) <= DISTANCE_VERTEX_BUDGET {
+            t *= 2;
+            longest /= 2.0;
+        }
     }
-    Ok(t)
+    let (surface_positions, surface_triangles) = if t == coarsest {
+        coarse
+    } else {
+        tessellated(surface, t)?
+    };
+    let a = mesh::spatial::MeshRef {
+        positions: &surface_positions,
+        triangles: &surface_triangles,
+    };
+    let b = mesh::spatial::MeshRef {
+        positions: &input,
+        triangles,
+    };
+    Ok((mesh::spatial::hausdorff(a, b)?, t))
 }
 
-/// The most vertices [`distance_resolution`] lets the tessellation have (genus 1 at 128 has
-/// 163 000; a plate of genus 10 at 64, 230 000, stays at 32).
+/// The most vertices [`hausdorff_to_mesh_resolved`] lets the tessellation have (genus 1 at 128
+/// has 163 000; a plate of genus 10 at 64, 230 000, stays at 32).
 pub const DISTANCE_VERTEX_BUDGET: f64 = 200_000.0;
 
-/// The `q` quantile of `values` (sorted in place), or `None` for none.
-fn percentile(values: &mut [f64], q: f64) -> Option<f64> {
+/// The length of every triangle's every edge (shared edges twice).
+fn edge_lengths(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<f64> {
+    let at = |v: u32| Point3::from(positions[v as usize]);
+    triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| (at(a) - at(b)).norm())
+        .collect()
+}
+
+/// The `q` quantile of `values` (nearest rank), or `None` for none.
+fn quantile(mut values: Vec<f64>, q: f64) -> Option<f64> {
     values.sort_by(f64::total_cmp);
-    let last = values.len().checked_sub(1)?;
-    Some(values[((last as f64) * q).round() as usize])
+    sorted_quantile(&values, q)
+}
+
+/// The `q` quantile (nearest rank) of values sorted ascending, or `None` for none.
+fn sorted_quantile(sorted: &[f64], q: f64) -> Option<f64> {
+    let last = sorted.len().checked_sub(1)?;
+    Some(sorted[(last as f64 * q).round() as usize])
 }
 
 /// [`tessellation_crossings`] at each resolution of `ts` in turn (coarse to fine), up to the first

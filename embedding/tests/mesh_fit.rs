@@ -301,14 +301,15 @@ fn gauss_bonnet_error(surface: &embedding::Surface, genus: u32) -> f64 {
 /// percentile.
 ///
 /// Its tessellation at 32 is as long along the tube as its map, so the distance to the mesh is
-/// measured finer (`quality::distance_resolution`): there it must agree with the distance at
+/// measured finer (`quality::hausdorff_to_mesh_resolved`): there it must agree with the distance at
 /// twice that resolution to 10%, where 32's may be off by more.
 #[test]
 fn a_knotted_tube_fits_closely() {
     use embedding::quality;
     let (positions, triangles) = shapes::trefoil_tube(160, 16, 0.45);
     let fit = assert_fits_within_issue_14s_targets(1, &positions, &triangles);
-    let t = quality::distance_resolution(&fit.surface, &positions, &triangles, 32, 128).unwrap();
+    let (resolved, t) =
+        quality::hausdorff_to_mesh_resolved(&fit.surface, &positions, &triangles, 32, 128).unwrap();
     let at = |t| {
         quality::hausdorff_to_mesh(&fit.surface, t, &positions, &triangles)
             .unwrap()
@@ -323,7 +324,8 @@ fn a_knotted_tube_fits_closely() {
         &triangles,
     );
     assert!(normals.p95 < 1.5, "{normals:?}");
-    let (coarse, chosen, finer) = (at(32), at(t), at(2 * t));
+    let (coarse, chosen, finer) = (at(32), resolved.symmetric, at(2 * t));
+    assert_eq!(chosen, at(t));
     eprintln!(
         "distance at 32: {coarse:e}, at {t}: {chosen:e}, at {}: {finer:e}",
         2 * t

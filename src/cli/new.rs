@@ -252,7 +252,7 @@ pub struct ShapeReport {
     /// anywhere, where the residual sees only the mesh's vertices. Reported, not gated.
     pub distance_to_input: f64,
     /// [`DISTANCE_SAMPLES`], or finer up to [`FINEST_DISTANCE_SAMPLES`] where its edges are longer
-    /// than the input's ([`embedding::quality::distance_resolution`]).
+    /// than the input's ([`embedding::quality::hausdorff_to_mesh_resolved`]).
     pub distance_samples: u32,
 }
 
@@ -296,18 +296,12 @@ fn measure_shape(
     };
     let normals = quality::normal_deviation_from(surface, at, reference);
     stage("measuring the distance to the input");
-    let distance_samples = quality::distance_resolution(
+    let (distance, distance_samples) = quality::hausdorff_to_mesh_resolved(
         surface,
         fitted.positions,
         fitted.triangles,
         DISTANCE_SAMPLES,
         FINEST_DISTANCE_SAMPLES,
-    )?;
-    let distance = quality::hausdorff_to_mesh(
-        surface,
-        distance_samples,
-        fitted.positions,
-        fitted.triangles,
     )?;
     stage("looking for self-intersections");
     let crossings = quality::crossings_until_clear(surface, &INTERSECTION_SAMPLES)?;

@@ -402,7 +402,7 @@ fn a_cage_whose_faces_disagree_is_refused_with_nothing_written() {
 /// conformal map squeezes their limbs (areas ×1 850, ×164 and ×37 on average), so the map is evened
 /// out in the plane: no folded triangle, and the surface within 3%, 7% and 20% of the diagonal of
 /// each mesh both ways (measured 2.0%, 5.4% and 16.1% on the tessellations of 64, 128 and 128 that
-/// `distance_resolution` picks; 2.1%, 4.9% and 13.0% at 32, whose chords hid some of the surface's
+/// `hausdorff_to_mesh_resolved` picks; 2.1%, 4.9% and 13.0% at 32, whose chords hid some of the surface's
 /// wandering; with the sweeps' map alone 228%, 16% and 31% at 32, and the cow folded a triangle). They still fail issue 14's normals and Gauss–Bonnet, so the
 /// fit exits 3 and writes the model only with --keep-failed.
 #[test]
