@@ -81,10 +81,15 @@ fn smoothed(mut metric: Vec<Metric>, g: usize) -> Vec<Metric> {
             for i in 0..g {
                 let mut sum = [0.0; 3];
                 let mut count = 0.0;
-                let neighbours = [(i, j), (i + 1, j), (i.wrapping_sub(1), j), (i, j + 1)]
-                    .into_iter()
-                    .chain([(i, j.wrapping_sub(1))]);
-                for (a, b) in neighbours.filter(|&(a, b)| a < g && b < g) {
+                // i − 1 or j − 1 wraps past g at the sides and is left out with i + 1 = g.
+                let neighbours = [
+                    (i, j),
+                    (i + 1, j),
+                    (i.wrapping_sub(1), j),
+                    (i, j + 1),
+                    (i, j.wrapping_sub(1)),
+                ];
+                for (a, b) in neighbours.into_iter().filter(|&(a, b)| a < g && b < g) {
                     let q = before[b * g + a];
                     (0..3).for_each(|k| sum[k] += q[k]);
                     count += 1.0;

@@ -1486,11 +1486,9 @@ fn solve_with(
     }
     let (rows, cols) = (data_rows + smooth.len(), layout.control_count());
     let mut rhs = Mat::<f64>::zeros(rows, 3);
-    for r in 0..data_rows {
-        for d in 0..3 {
-            rhs[(r, d)] = data.rhs[(r, d)];
-        }
-    }
+    rhs.as_mut()
+        .subrows_mut(0, data_rows)
+        .copy_from(data.rhs.as_ref());
     let x = least_squares(rows, cols, &triplets, &rhs)?;
     let control: Vec<Point3> = (0..cols)
         .map(|c| Point3::new(x[(c, 0)], x[(c, 1)], x[(c, 2)]))
