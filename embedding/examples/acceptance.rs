@@ -16,7 +16,7 @@ use std::time::Instant;
 use embedding::fit::FitSettings;
 use embedding::holed::HoledMesh;
 use embedding::integrals::{cells_per_knot, surface_integrals};
-use embedding::mesh_fit::{self, mesh_model};
+use embedding::mesh_fit;
 use embedding::quality;
 use embedding::{Point3, SplineSettings};
 
@@ -93,10 +93,12 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
         stretch_rounds: rounds,
         even_rounds: env("EVEN").map_or(fit_defaults.even_rounds, |r| r as usize),
         smoothness: env("SMOOTHNESS").unwrap_or(embedding::fit::default_smoothness(grid)),
+        raise_smoothness: env("SMOOTHNESS").is_none(),
         ..fit_defaults
     };
-    let fit = match mesh_model(positions, triangles, settings, fit_settings, &|_| {}) {
-        Ok(fit) => fit,
+    let user = match mesh_fit::fit_user_mesh(positions, triangles, settings, fit_settings, &|_| {})
+    {
+        Ok(user) => user,
         Err(e) => {
             println!(
                 "{name}: {} vertices, {} triangles: {e}",
@@ -106,6 +108,12 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
             return;
         }
     };
+    if let Some(split) = &user.split {
+        println!("  long edges split: {} vertices added", split.added);
+    }
+    // As `ntori fit` measures: on the mesh the fit went through (the same surface).
+    let (positions, triangles) = user.mesh(positions, triangles);
+    let fit = user.fit.clone();
     let seconds = start.elapsed().as_secs_f64();
     let diagonal = fit.mesh_diagonal;
     let surface = &fit.surface;

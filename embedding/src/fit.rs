@@ -235,6 +235,10 @@ pub struct FitSettings {
     /// solved twice, the second time with the first's metric. For maps that stretch the surface
     /// more one way than the other (a user's tubes and limbs); `new`'s plates keep the grids' term.
     pub surface_smoothness: bool,
+    /// Where the fitted surface is rough by `ntori fit`'s shape checks, fit again with a larger
+    /// smoothness (a user's mesh: [`crate::mesh_fit`]'s `smooth_enough`); off where the user
+    /// chose λ.
+    pub raise_smoothness: bool,
 }
 
 impl Default for FitSettings {
@@ -246,6 +250,7 @@ impl Default for FitSettings {
             sweeps: 5000,
             even_rounds: crate::mesh_fit::EVEN_ROUNDS,
             surface_smoothness: false,
+            raise_smoothness: false,
         }
     }
 }

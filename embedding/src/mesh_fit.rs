@@ -38,6 +38,7 @@ use crate::fit::{
     fit, stereographic_points, vertex_areas,
 };
 use crate::harmonic::Convergence;
+use crate::quality;
 use crate::sphere_map::{EXTRA_ROUNDS, sphere_map};
 use crate::spline_surface::Surface;
 use crate::surface::{Layout, Point3, SplineSettings};
@@ -131,6 +132,7 @@ pub fn default_settings(genus: u32) -> (SplineSettings, FitSettings) {
     };
     let fit = FitSettings {
         surface_smoothness: surface_smoothness(genus),
+        raise_smoothness: true,
         ..FitSettings::for_grid(grid)
     };
     (spline, fit)
@@ -166,6 +168,8 @@ pub fn surface_smoothness(genus: u32) -> bool {
 pub struct MeshFit {
     pub surface: Surface,
     pub genus: u32,
+    /// The smoothness weight the fit used ([`smooth_enough`]).
+    pub smoothness: SmoothnessReport,
     /// The mesh's vertices' surface points (one per vertex), the relaxation's sweeps and folds.
     pub parameterization: Parameterization,
     /// The loop system the map was built from.
@@ -231,6 +235,7 @@ pub fn mesh_model(
         layout: &layout,
         genus,
         positions,
+        triangles,
         areas: &areas,
     };
     let Some(polygon) = atlas.polygon() else {
@@ -254,7 +259,8 @@ pub fn mesh_model(
     };
     // Evening helps where the mesh's thin triangles turn from place to place (marching cubes) and
     // can blur a map that was smooth already; the fit through the mesh's own vertices says which:
-    // the map whose parameters let a smooth surface come closer to them is kept.
+    // the map whose parameters let a smooth surface come closer to them is kept (of those whose
+    // surface is smooth enough, where only one is).
     let evened_areas = vertex_areas(&evening.positions, triangles);
     let evened = fit_through(&evening.positions, &evened_areas, Some(positions))?;
     let as_it_is = fit_through(positions, &areas, None)?;
@@ -265,7 +271,11 @@ pub fn mesh_model(
         largest_move: evening.largest_move,
         max_residual_evened: evened.max_residual,
         max_residual_as_it_is: as_it_is.max_residual,
-        kept: evened.max_residual < as_it_is.max_residual,
+        kept: match (evened.smoothness.passed(), as_it_is.smoothness.passed()) {
+            (true, false) => true,
+            (false, true) => false,
+            _ => evened.max_residual < as_it_is.max_residual,
+        },
     };
     let kept = if report.kept { evened } else { as_it_is };
     Ok(MeshFit {
@@ -280,6 +290,7 @@ struct MeshInput<'a> {
     layout: &'a Layout<'a>,
     genus: u32,
     positions: &'a [Point3],
+    triangles: &'a [[u32; 3]],
     areas: &'a [f64],
 }
 
@@ -291,25 +302,26 @@ fn finish(
     progress: &dyn Fn(FitStage),
 ) -> Result<MeshFit, EmbeddingError> {
     let MeshInput {
-        atlas,
         layout,
         genus,
         positions,
-        areas,
+        ..
     } = *input;
     progress(FitStage::Fitting);
     let points = mapped.points;
-    let control = fit(layout, &points, positions, areas, fit_settings)?;
+    let diagonal = diagonal(positions);
+    let (surface, smoothness) = smooth_enough(input, &points, fit_settings, diagonal)?;
+    let control = surface.control_points();
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (p, target) in points.iter().zip(positions) {
-        let e = (layout.eval(&control, *p).pos - target).norm();
+        let e = (layout.eval(control, *p).pos - target).norm();
         sum += e * e;
         max = max.max(e);
     }
-    let surface = Surface::new(Arc::clone(atlas), layout.settings(), control)?;
     Ok(MeshFit {
         surface,
         genus,
+        smoothness,
         parameterization: Parameterization {
             points,
             disk: None,
@@ -326,8 +338,159 @@ fn finish(
         evening: None,
         rms_residual: (sum / positions.len() as f64).sqrt(),
         max_residual: max,
-        mesh_diagonal: diagonal(positions),
+        mesh_diagonal: diagonal,
     })
+}
+
+/// Each step of [`smooth_enough`]'s ladder multiplies λ by this.
+pub const SMOOTHNESS_STEP: f64 = 5.0;
+/// The largest λ [`smooth_enough`] raises the smoothness to (its last step is cut to it).
+pub const MAX_RAISED_SMOOTHNESS: f64 = 1.0;
+/// Tessellation of the points where [`Roughness`] is measured (`ntori fit`'s shape checks use the
+/// same).
+pub const ROUGHNESS_SAMPLES: u32 = 16;
+
+/// How far a fitted surface is from what `ntori fit`'s checks accept, measured cheaply (at the
+/// t = [`ROUGHNESS_SAMPLES`] tessellation's vertices and the mesh's own): its largest |κ| against
+/// the mesh's ([`quality::CURVATURE_RATIO_TOLERANCE_MESH`]), its patches' disagreement
+/// ([`quality::DISAGREEMENT_TOLERANCE`]) and its largest distance from the mesh's vertices
+/// ([`quality::RESIDUAL_TOLERANCE`]), which smoothing trades against the other two.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Roughness {
+    /// The surface's largest |κ| over the mesh's.
+    pub curvature_ratio: f64,
+    /// The largest disagreement of two patches, and the largest residual, as fractions of the
+    /// mesh's diagonal.
+    pub disagreement: f64,
+    pub residual: f64,
+}
+
+impl Roughness {
+    fn measure(
+        surface: &Surface,
+        data: (&[ChartPoint], &[Point3]),
+        input_curvature: f64,
+        diagonal: f64,
+    ) -> Result<Roughness, EmbeddingError> {
+        let points = quality::sample_points(surface, ROUGHNESS_SAMPLES)?;
+        let largest = quality::max_principal_curvature(surface, &points).max_abs;
+        let disagreement = quality::patch_disagreement(surface, &points, 0.1).max;
+        Ok(Roughness {
+            curvature_ratio: largest / input_curvature,
+            disagreement: disagreement / diagonal,
+            residual: largest_residual(surface, data.0, data.1) / diagonal,
+        })
+    }
+
+    /// The largest of the measures as a multiple of its tolerance: at most 1 passes.
+    pub fn excess(&self) -> f64 {
+        let excess = [
+            self.curvature_ratio / quality::CURVATURE_RATIO_TOLERANCE_MESH,
+            self.disagreement / quality::DISAGREEMENT_TOLERANCE,
+            self.residual / quality::RESIDUAL_TOLERANCE,
+        ]
+        .into_iter()
+        .fold(0.0, f64::max);
+        // A non-finite measure (a degenerate surface) is as bad as it gets.
+        if excess.is_nan() {
+            f64::INFINITY
+        } else {
+            excess
+        }
+    }
+}
+
+/// The largest |S(p_i) − P_i|.
+fn largest_residual(surface: &Surface, points: &[ChartPoint], targets: &[Point3]) -> f64 {
+    let (layout, control) = (surface.layout(), surface.control_points());
+    points
+        .iter()
+        .zip(targets)
+        .map(|(p, target)| (layout.eval(control, *p).pos - target).norm())
+        .fold(0.0, f64::max)
+}
+
+/// The smoothness weight a fit used, and why.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SmoothnessReport {
+    /// λ as set, and as used.
+    pub asked: f64,
+    pub used: f64,
+    /// Each λ tried (from `asked`) and its surface's roughness.
+    pub tried: Vec<(f64, Roughness)>,
+}
+
+impl SmoothnessReport {
+    /// Whether the surface kept passed [`Roughness`]'s measure (true where none was taken).
+    pub fn passed(&self) -> bool {
+        self.tried
+            .iter()
+            .find(|(smoothness, _)| *smoothness == self.used)
+            .is_none_or(|(_, roughness)| roughness.excess() <= 1.0)
+    }
+}
+
+/// The fit through the mesh's vertices at `points` with `fit_settings`'s λ, and, where
+/// [`FitSettings::raise_smoothness`] says so and that surface is rough (its [`Roughness`] fails),
+/// again with λ raised [`SMOOTHNESS_STEP`]-fold at a time up to [`MAX_RAISED_SMOOTHNESS`] until
+/// one passes; the first that passes is kept, else the least rough.
+///
+/// Why: a smooth surface cannot follow a sharp edge. Through the vertices on both sides of one
+/// (a CAD part's rims, a gear's teeth) the default λ rings: CGAL's `pinion.off` (its long edges
+/// split) read |κ| 54 711 times its mesh's, 2 538 crossing pairs and normals 65° off at the 90th
+/// percentile; at λ = 1 it is a fair, rounded gear (1.66×, no crossing), 2.8% of the diagonal from
+/// the mesh. Smooth shapes pass at the default and are fitted once, as before.
+fn smooth_enough(
+    input: &MeshInput,
+    points: &[ChartPoint],
+    fit_settings: FitSettings,
+    diagonal: f64,
+) -> Result<(Surface, SmoothnessReport), EmbeddingError> {
+    let MeshInput {
+        atlas,
+        layout,
+        positions,
+        triangles,
+        areas,
+        ..
+    } = *input;
+    let fit_with = |smoothness: f64| -> Result<Surface, EmbeddingError> {
+        let settings = FitSettings {
+            smoothness,
+            ..fit_settings
+        };
+        let control = fit(layout, points, positions, areas, settings)?;
+        Surface::new(Arc::clone(atlas), layout.settings(), control)
+    };
+    let asked = fit_settings.smoothness;
+    let surface = fit_with(asked)?;
+    let mut report = SmoothnessReport {
+        asked,
+        used: asked,
+        tried: Vec::new(),
+    };
+    if !fit_settings.raise_smoothness {
+        return Ok((surface, report));
+    }
+    let normals = quality::vertex_normals(positions, triangles);
+    let input_curvature = quality::mesh_max_principal_curvature(positions, triangles, &normals);
+    let data = (points, positions);
+    let roughness = Roughness::measure(&surface, data, input_curvature, diagonal)?;
+    let mut best = (surface, asked, roughness);
+    report.tried.push((asked, best.2));
+    let mut smoothness = asked;
+    while best.2.excess() > 1.0 && smoothness < MAX_RAISED_SMOOTHNESS {
+        smoothness = (smoothness * SMOOTHNESS_STEP).min(MAX_RAISED_SMOOTHNESS);
+        let surface = fit_with(smoothness)?;
+        let roughness = Roughness::measure(&surface, data, input_curvature, diagonal)?;
+        report.tried.push((smoothness, roughness));
+        tracing::debug!(smoothness, ?roughness, "raised the fit's smoothness");
+        if roughness.excess() < best.2.excess() || roughness.excess() <= 1.0 {
+            best = (surface, smoothness, roughness);
+        }
+    }
+    report.used = best.1;
+    Ok((best.0, report))
 }
 
 /// Every mesh vertex's surface point, and how the map that gave them went.
@@ -506,6 +669,120 @@ fn resample(lifts: &Lifts, positions: &[Point3], samples: &[Point3]) -> Vec<Comp
                 .apply(z[0] * b[0] + z[1] * b[1] + z[2] * b[2])
         })
         .collect()
+}
+
+/// Edges longer than this many times the mesh's shorter edges (the lower quartile of the lengths)
+/// are split before the map and the fit ([`split_long_edges`]).
+///
+/// The lower quartile, not the median, is the mesh's own spacing where it is sampled: a CAD
+/// tessellation's long edges (its faces' needles) can be most of its edges, and a mesh made as a
+/// grid or a remesher makes it has all its edges within a factor of 3 of it. Measured on the
+/// meshes at hand: the largest edge is 1.4 to 2.8 times the lower quartile on the assets, LaPy's
+/// torus, CGAL's knot, `eight.off`, pymeshlab's bone and airplane, and 19.5 and 24.1 times on
+/// CGAL's `pinion.off` and `3torus-smooth.off` (26% and 24% of their edges split).
+pub const LONG_EDGE_FACTOR: f64 = 3.0;
+
+/// A user's mesh with its long edges split (see [`mesh::refine`]): the same surface, sampled by
+/// vertices about as densely everywhere.
+#[derive(Clone, Debug)]
+pub struct SplitMesh {
+    pub positions: Vec<Point3>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Vertices added, and the length no edge is longer than now.
+    pub added: usize,
+    pub limit: f64,
+}
+
+/// `positions`, `triangles` with every edge longer than [`LONG_EDGE_FACTOR`] times the lower
+/// quartile of the edges' lengths split at its midpoint (longest first), or `None` where no edge
+/// is that long. At most [`crate::fit::MAX_FIT_TRIANGLES`] / 2 vertices in all.
+pub fn split_long_edges(positions: &[Point3], triangles: &[[u32; 3]]) -> Option<SplitMesh> {
+    let mut lengths: Vec<f64> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .filter(|(a, b)| a < b)
+        .map(|(a, b)| (positions[a as usize] - positions[b as usize]).norm())
+        .collect();
+    if lengths.is_empty() {
+        return None;
+    }
+    let quarter = lengths.len() / 4;
+    let lower_quartile = *lengths.select_nth_unstable_by(quarter, f64::total_cmp).1;
+    let limit = LONG_EDGE_FACTOR * lower_quartile;
+    let raw: Vec<[f64; 3]> = positions.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let cap = (crate::fit::MAX_FIT_TRIANGLES / 2).max(positions.len());
+    let refined = mesh::refine::split_long_edges(&raw, triangles, limit, cap);
+    (refined.added > 0).then(|| SplitMesh {
+        positions: refined.positions.into_iter().map(Point3::from).collect(),
+        triangles: refined.triangles,
+        added: refined.added,
+        limit,
+    })
+}
+
+/// A user's mesh fitted as `ntori fit` and the editor's import fit it ([`fit_user_mesh`]).
+#[derive(Clone, Debug)]
+pub struct UserMeshFit {
+    pub fit: MeshFit,
+    /// The mesh the fit went through, where its long edges were split (the fit's points are its
+    /// vertices then).
+    pub split: Option<SplitMesh>,
+    /// Where the split mesh's map failed: why (the mesh was then fitted as it is).
+    pub split_failed: Option<String>,
+}
+
+impl UserMeshFit {
+    /// The mesh the fit went through: the split one, or `positions`, `triangles` as given.
+    pub fn mesh<'a>(
+        &'a self,
+        positions: &'a [Point3],
+        triangles: &'a [[u32; 3]],
+    ) -> (&'a [Point3], &'a [[u32; 3]]) {
+        self.split
+            .as_ref()
+            .map_or((positions, triangles), |s| (&s.positions, &s.triangles))
+    }
+}
+
+/// [`mesh_model`] through the mesh with its long edges split ([`split_long_edges`]), or as it is
+/// where none is long or the split mesh's map fails (the midpoints of a coarse mesh's long edges
+/// can leave Newton's method without a fixed point: CGAL's 244-vertex genus-4 `fertility`).
+pub fn fit_user_mesh(
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    settings: SplineSettings,
+    fit_settings: FitSettings,
+    progress: &dyn Fn(FitStage),
+) -> Result<UserMeshFit, EmbeddingError> {
+    let mut split_failed = None;
+    if let Some(split) = split_long_edges(positions, triangles) {
+        match mesh_model(
+            &split.positions,
+            &split.triangles,
+            settings,
+            fit_settings,
+            progress,
+        ) {
+            Ok(fit) => {
+                return Ok(UserMeshFit {
+                    fit,
+                    split: Some(split),
+                    split_failed: None,
+                });
+            }
+            Err(EmbeddingError::Parameterization(why)) => {
+                tracing::info!(%why, "the mesh with its long edges split did not map; fitting it as it is");
+                split_failed = Some(why);
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    let fit = mesh_model(positions, triangles, settings, fit_settings, progress)?;
+    Ok(UserMeshFit {
+        fit,
+        split: None,
+        split_failed,
+    })
 }
 
 /// The mesh evened out along its own surface for the map ([`mesh::even`]), and what that did, or

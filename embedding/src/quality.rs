@@ -35,6 +35,19 @@ use crate::spline_surface::Surface;
 use crate::surface::{Point3, Vector3};
 use crate::{EmbeddingError, evaluate};
 
+/// Largest distance of a fit from its data points, as a fraction of the diagonal, that `ntori new`
+/// and `ntori fit` accept.
+pub const RESIDUAL_TOLERANCE: f64 = 0.01;
+/// Largest patch disagreement, as a fraction of the diagonal, that `ntori new` and `ntori fit`
+/// accept.
+pub const DISAGREEMENT_TOLERANCE: f64 = 0.01;
+/// Largest ratio of a surface's |κ| to its input mesh's that `ntori fit` accepts (a crease or a
+/// spike), where the input's comes from the mesh's own normals: those underestimate the peak of a
+/// coarse mesh, whose triangles each span much of a rim's turn (the 1581-vertex
+/// `assets/meshes/plate-genus-3.obj` reads 3.1 against its shape's 4.0). Against a shape's exact
+/// normals (`ntori new`) the check takes 3.
+pub const CURVATURE_RATIO_TOLERANCE_MESH: f64 = 4.0;
+
 /// Points spread over the whole surface: the vertices of its t × t tessellation.
 pub fn sample_points(surface: &Surface, t: u32) -> Result<Vec<ChartPoint>, EmbeddingError> {
     Ok(surface.atlas().tessellate(t, t)?.vertices)

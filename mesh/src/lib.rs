@@ -7,6 +7,7 @@
 //! - [`cell_complex`] views a mesh as a cell complex with oriented 1-cells and validates one.
 //! - [`spatial`] checks triangle meshes in R³: exact self-intersections, degenerate triangles and
 //!   Hausdorff distances.
+//! - [`refine`] splits a mesh's long edges (the surface stays where it is).
 //! - [`validate`] locates what the topology counts: the first non-manifold edge or vertex, the
 //!   boundary loops, where orientation breaks down, each face's component.
 //!
@@ -25,6 +26,7 @@
 pub mod cell_complex;
 pub mod even;
 pub mod halfedge;
+pub mod refine;
 pub mod schema;
 pub mod shape;
 pub mod spatial;

@@ -5,7 +5,10 @@ use std::process::ExitCode;
 
 use anyhow::Context as _;
 use embedding::fit::FitStage;
-use embedding::mesh_fit::{MeshFit, mesh_fit_disk_grid, mesh_fit_grid, mesh_model};
+use embedding::mesh_fit::{
+    LONG_EDGE_FACTOR, MeshFit, SmoothnessReport, UserMeshFit, fit_user_mesh, mesh_fit_disk_grid,
+    mesh_fit_grid, mesh_model,
+};
 use ntori::io::import::{self, ValidMesh, cage};
 use serde::Serialize;
 
@@ -114,16 +117,36 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     fit.even_rounds = args.even_rounds as usize;
     fit.surface_smoothness = embedding::mesh_fit::surface_smoothness(valid.genus);
+    // λ is raised where the default leaves the surface rough, not where the user chose it.
+    fit.raise_smoothness = args.spline.smoothness.is_none();
     let progress = FitProgress::new(args.quiet);
-    let fitted = mesh_model(
-        &valid.positions,
-        &valid.triangles,
-        settings,
-        fit,
-        &|s: FitStage| progress.fit_stage(s),
-    )
+    let fit_stage = |s: FitStage| progress.fit_stage(s);
+    let user = match cage {
+        // A cage's limit mesh is refined evenly already, and its normals are its vertices'.
+        Some(_) => mesh_model(
+            &valid.positions,
+            &valid.triangles,
+            settings,
+            fit,
+            &fit_stage,
+        )
+        .map(|fit| UserMeshFit {
+            fit,
+            split: None,
+            split_failed: None,
+        }),
+        None => fit_user_mesh(
+            &valid.positions,
+            &valid.triangles,
+            settings,
+            fit,
+            &fit_stage,
+        ),
+    }
     .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
-    let mut checked = as_fitted(&fitted, &valid, settings, fit.smoothness);
+    let fitted = &user.fit;
+    let (positions, triangles) = user.mesh(&valid.positions, &valid.triangles);
+    let mut checked = as_fitted(fitted, positions, triangles, settings);
     checked.intended_normals = cage.as_ref().map(|c| &c.normals[..]);
     let report = check(&checked, start, &|s| progress.stage(s))?;
     progress.finish();
@@ -153,8 +176,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             // outward: what was done to the file is the cage's.
             flipped: cage.as_ref().map_or(valid.flipped, |c| c.report.flipped),
             cage: cage.map(|c| c.report),
+            split: user.split.as_ref().map(|s| SplitReport {
+                added_vertices: s.added,
+                longest_edge: s.limit,
+            }),
+            split_failed: user.split_failed.clone(),
         },
-        loops: LoopsReport::of(&fitted),
+        smoothness: fitted.smoothness.clone(),
+        loops: LoopsReport::of(fitted),
         fit: report,
         output: &args.output,
         written,
@@ -214,22 +243,22 @@ struct CageReport {
 
 fn as_fitted<'a>(
     fit: &'a MeshFit,
-    valid: &'a ValidMesh,
+    positions: &'a [embedding::Point3],
+    triangles: &'a [[u32; 3]],
     settings: embedding::SplineSettings,
-    smoothness: f64,
 ) -> Fitted<'a> {
     Fitted {
         surface: &fit.surface,
         genus: fit.genus,
         parameterization: &fit.parameterization,
-        positions: &valid.positions,
-        triangles: &valid.triangles,
+        positions,
+        triangles,
         intended_normals: None,
         rms_residual: fit.rms_residual,
         max_residual: fit.max_residual,
         mesh_diagonal: fit.mesh_diagonal,
         settings,
-        smoothness,
+        smoothness: fit.smoothness.used,
     }
 }
 
@@ -240,6 +269,8 @@ struct FitReport<'a> {
     loops: LoopsReport,
     /// How the mesh was evened out for its map, where it has long thin triangles.
     evening: Option<EveningReport>,
+    /// The smoothness weight asked for and used, and each one tried where it was raised.
+    smoothness: SmoothnessReport,
     fit: NewReport,
     #[serde(skip)]
     output: &'a Path,
@@ -258,6 +289,19 @@ struct InputReport {
     flipped: bool,
     /// With --cage: the cage and its refinement.
     cage: Option<CageReport>,
+    /// Where the mesh had long edges: how they were split for the fit.
+    split: Option<SplitReport>,
+    /// Where the mesh with its long edges split did not map: why (it was fitted as it is).
+    split_failed: Option<String>,
+}
+
+/// Long edges split at their midpoints before the map and the fit
+/// (`embedding::mesh_fit::split_long_edges`): the surface is the same, sampled more densely.
+#[derive(Serialize)]
+struct SplitReport {
+    added_vertices: usize,
+    /// No edge is longer than this now (model units): `LONG_EDGE_FACTOR` times the lower quartile.
+    longest_edge: f64,
 }
 
 /// Vertices near long thin triangles slid along the mesh for a second map (the fit's data stay
@@ -382,6 +426,47 @@ impl Report for FitReport<'_> {
                 c.faces, c.non_quads, c.level, c.limit_vertices
             )
         });
-        format!("read {}{notes}\n{cage}{loops}\n{evening}", i.path) + &self.fit.to_text() + &outcome
+        let split_failed = i.split_failed.as_ref().map_or(String::new(), |why| {
+            format!("long edges: the mesh with them split did not map ({why}); fitted as it is\n")
+        });
+        let split = i.split.as_ref().map_or(split_failed, |s| {
+            format!(
+                "long edges: split at their midpoints until none is longer than {:.4} ({LONG_EDGE_FACTOR} \
+                 times the lower quartile), {} vertices added, so the fit sees the faces they spanned\n",
+                s.longest_edge, s.added_vertices
+            )
+        });
+        let smoothness = smoothness_text(&self.smoothness);
+        format!(
+            "read {}{notes}\n{cage}{split}{loops}\n{evening}{smoothness}",
+            i.path
+        ) + &self.fit.to_text()
+            + &outcome
     }
+}
+
+/// The line saying that λ was raised, and why (nothing where the first λ passed or none was tried).
+fn smoothness_text(report: &SmoothnessReport) -> String {
+    let (Some((asked, first)), Some((_, last))) = (
+        report.tried.first(),
+        report.tried.iter().find(|(l, _)| *l == report.used),
+    ) else {
+        return String::new();
+    };
+    if report.used == report.asked {
+        return String::new();
+    }
+    let largest = report.tried.last().map_or(report.used, |t| t.0);
+    format!(
+        "smoothness: λ raised from {asked} to {} (tried up to {largest}): at {asked} the surface's \
+         largest |κ| was {:.2}× the mesh's and its patches {:.3}% of the diagonal apart, at {} \
+         {:.2}× and {:.3}% (t = {})\n",
+        report.used,
+        first.curvature_ratio,
+        100.0 * first.disagreement,
+        report.used,
+        last.curvature_ratio,
+        100.0 * last.disagreement,
+        embedding::mesh_fit::ROUGHNESS_SAMPLES,
+    )
 }

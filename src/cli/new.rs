@@ -374,15 +374,14 @@ pub enum NormalReference {
 /// Largest relative Gauss–Bonnet error the check accepts (relative to ∫|K| dA for the torus).
 pub const CURVATURE_TOLERANCE: f64 = 1e-3;
 /// Largest residual, as a fraction of the diagonal, the check accepts.
-pub const RESIDUAL_TOLERANCE: f64 = 0.01;
+pub const RESIDUAL_TOLERANCE: f64 = embedding::quality::RESIDUAL_TOLERANCE;
 /// Largest patch disagreement, as a fraction of the diagonal, the check accepts.
-pub const DISAGREEMENT_TOLERANCE: f64 = 0.01;
+pub const DISAGREEMENT_TOLERANCE: f64 = embedding::quality::DISAGREEMENT_TOLERANCE;
 /// Largest ratio of the surface's |κ| to the input's the check accepts (a crease or a spike), where
-/// the input's comes from the intended shape's exact normals, and where it comes from a mesh's own:
-/// those underestimate the peak of a coarse mesh, whose triangles each span much of a rim's turn
-/// (the 1581-vertex `assets/meshes/plate-genus-3.obj` reads 3.1 against its shape's 4.0).
+/// the input's comes from the intended shape's exact normals, and where it comes from a mesh's own
+/// ([`embedding::quality::CURVATURE_RATIO_TOLERANCE_MESH`] says why that is larger).
 pub const CURVATURE_RATIO_TOLERANCE_INTENDED: f64 = 3.0;
-pub const CURVATURE_RATIO_TOLERANCE_MESH: f64 = 4.0;
+pub const CURVATURE_RATIO_TOLERANCE_MESH: f64 = embedding::quality::CURVATURE_RATIO_TOLERANCE_MESH;
 /// Largest 90th percentile of the normal deviation (degrees) the check accepts, against the
 /// intended shape's exact normals and against a mesh's own (which carry its faceting).
 pub const NORMAL_TOLERANCE_INTENDED: f64 = 5.0;

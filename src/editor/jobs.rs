@@ -7,7 +7,7 @@ use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
 use embedding::fit::{FitSettings, default_resolution, initial_model, vertex_areas};
-use embedding::mesh_fit::{self, mesh_model};
+use embedding::mesh_fit::{self, fit_user_mesh};
 use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
 use super::state::EditorError;
@@ -132,13 +132,14 @@ impl Jobs {
                 .map_err(|e| JobError::Import(format!("{}: {e}", path.display())))?;
             // `ntori fit`'s settings.
             let (settings, fit_settings) = mesh_fit::default_settings(valid.genus);
-            let fit = mesh_model(
+            let fit = fit_user_mesh(
                 &valid.positions,
                 &valid.triangles,
                 settings,
                 fit_settings,
                 &|_| {},
             )
+            .map(|user| user.fit)
             .map_err(|source| JobError::ImportFit {
                 path: path.clone(),
                 source,

@@ -313,3 +313,58 @@ fn animal_field(p: Point3) -> f64 {
         0.12,
     )
 }
+
+/// A gear as CAD programs tessellate one (genus 1): a prism of `height` over an annulus whose
+/// outer rim is r(θ) = 1 + 0.12 cos(`teeth` θ) (rounded teeth) and inner rim 0.45, with vertices
+/// only on the four rims, `segments` on each. The walls are single needle triangles from the top
+/// rim to the bottom one (about `height` / (2π / `segments`) times longer than wide), and the rims
+/// are sharp edges.
+pub fn needle_gear(segments: usize, teeth: f64, height: f64) -> Mesh {
+    let n = segments;
+    let rim = |k: usize, outer: bool, z: f64| {
+        let theta = std::f64::consts::TAU * (k % n) as f64 / n as f64;
+        let r = if outer {
+            1.0 + 0.12 * (teeth * theta).cos()
+        } else {
+            0.45
+        };
+        Point3::new(r * theta.cos(), r * theta.sin(), z)
+    };
+    let mut positions = Vec::with_capacity(4 * n);
+    for (outer, z) in [(true, height), (false, height), (true, 0.0), (false, 0.0)] {
+        positions.extend((0..n).map(|k| rim(k, outer, z)));
+    }
+    let index = |ring: usize, k: usize| (ring * n + k % n) as u32;
+    let (top_out, top_in, bottom_out, bottom_in) = (0, 1, 2, 3);
+    let mut triangles = Vec::with_capacity(8 * n);
+    for k in 0..n {
+        let quads = [
+            // Top (+z), bottom (−z), outer wall (outwards), inner wall (towards the axis).
+            [(top_out, k), (top_out, k + 1), (top_in, k + 1), (top_in, k)],
+            [
+                (bottom_out, k),
+                (bottom_in, k),
+                (bottom_in, k + 1),
+                (bottom_out, k + 1),
+            ],
+            [
+                (top_out, k),
+                (bottom_out, k),
+                (bottom_out, k + 1),
+                (top_out, k + 1),
+            ],
+            [
+                (top_in, k),
+                (top_in, k + 1),
+                (bottom_in, k + 1),
+                (bottom_in, k),
+            ],
+        ];
+        for q in quads {
+            let [a, b, c, d] = q.map(|(ring, k)| index(ring, k));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    (positions, triangles)
+}
