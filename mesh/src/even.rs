@@ -187,15 +187,6 @@ fn project(
 }
 
 /// Vertices on an edge whose triangles' normals turn more than [`SHARP_DIHEDRAL_DEGREES`].
-/// Vertices on an edge whose triangles' normals differ by more than [`SHARP_DIHEDRAL_DEGREES`].
-pub fn sharp_corners(positions: &[Point], triangles: &[[u32; 3]]) -> Vec<bool> {
-    let normals: Vec<Point> = triangles
-        .iter()
-        .map(|t| unit_normal(t.map(|v| positions[v as usize])))
-        .collect();
-    sharp_vertices(positions.len(), triangles, &normals)
-}
-
 fn sharp_vertices(n: usize, triangles: &[[u32; 3]], normals: &[Point]) -> Vec<bool> {
     let cos_sharp = SHARP_DIHEDRAL_DEGREES.to_radians().cos();
     let mut edges: std::collections::HashMap<(u32, u32), usize> =
