@@ -21,6 +21,8 @@ use super::{FitArgs, FitProgress};
 /// The mesh is read (polygons triangulated, coincident vertices merged where the format stores
 /// none) and checked: one closed, consistently oriented manifold without degenerate triangles, or
 /// an error that says what is wrong and where. Its genus comes from its Euler characteristic.
+/// Edges longer than three times the mesh's lower-quartile edge (a CAD tessellation's needles) are
+/// split at their midpoints, so the fit sees the faces they span; the surface stays where it is.
 ///
 /// A system of 2g loops through one vertex is grown (a shortest-path tree and its dual), the
 /// relation the loops satisfy is brought to the canonical form a₁ b₁ a₁⁻¹ b₁⁻¹ …, and every edge
@@ -31,13 +33,17 @@ use super::{FitArgs, FitProgress};
 /// many long thin irregular triangles (a fifth or more with an angle under 20°, as marching cubes
 /// and scanners make) is also mapped evened out along its own surface, a map that does not follow
 /// the triangles' directions; the fit's data stay the mesh's own vertices, and the map whose fit
-/// comes closer to them is kept. If a check
+/// comes closer to them is kept. Where the fit at the default smoothness is rough by the checks
+/// (|κ| over 4× the mesh's, patches over 1% apart, a residual over 1%: a smooth surface rings
+/// beside sharp edges), it is fitted again with λ five times larger, up to 1, and the first that
+/// passes, else the least rough, is kept; --smoothness fixes λ. If a check
 /// fails, no model is written (unless --keep-failed) and the exit status is 3. A genus-0 mesh is
 /// mapped onto the sphere instead (no loops); where the relaxation there leaves long limbs
 /// squeezed, the map is made again in rounds of planar solves that even its area out.
 ///
 /// Examples:
-///   ntori fit assets/meshes/pretzel.obj -o pretzel.json
+///   ntori fit assets/meshes/plate-genus-3.obj -o plate.json
+///   ntori fit assets/meshes/gear-genus-1.obj -o gear.json --keep-failed
 ///   ntori fit scan.stl --largest --grid 16
 ///   ntori fit assets/meshes/slab-genus-2-cage.obj --cage
 #[derive(clap::Args, Debug)]

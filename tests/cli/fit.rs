@@ -451,11 +451,12 @@ fn a_cage_whose_faces_disagree_is_refused_with_nothing_written() {
 /// Real genus-0 meshes with long limbs, from pymeshlab's samples (`pip install pymeshlab`; .ci/run
 /// installs it): a bone (1 513 vertices), an airplane (5 400) and a cow (2 904). The sphere's
 /// conformal map squeezes their limbs (areas ×1 850, ×164 and ×37 on average), so the map is evened
-/// out in the plane: no folded triangle, and the surface within 3%, 7% and 20% of the diagonal of
-/// each mesh both ways (measured 2.0%, 5.4% and 16.1% on the tessellations of 64, 128 and 128 that
-/// `hausdorff_to_mesh_resolved` picks; 2.1%, 4.9% and 13.0% at 32, whose chords hid some of the surface's
-/// wandering; with the sweeps' map alone 228%, 16% and 31% at 32, and the cow folded a triangle). They still fail issue 14's normals and Gauss–Bonnet, so the
-/// fit exits 3 and writes the model only with --keep-failed.
+/// out in the plane: no folded triangle, and the surface within 3%, 4% and 12% of the diagonal of
+/// each mesh both ways (measured 2.1%, 2.3% and 8.8% on the tessellations that
+/// `hausdorff_to_mesh_resolved` picks, with λ raised where the default is rough: at the default
+/// λ 2.0%, 5.4% and 16.1%; with the sweeps' map alone 228%, 16% and 31% at 32, and the cow folded a
+/// triangle). They still fail issue 14's normals and curvature, so the fit exits 3 and writes the
+/// model only with --keep-failed.
 #[test]
 fn real_genus_zero_meshes_with_long_limbs_are_evened_out_and_fit_without_a_fold() {
     let Some(samples) = pymeshlab_samples() else {
@@ -464,8 +465,8 @@ fn real_genus_zero_meshes_with_long_limbs_are_evened_out_and_fit_without_a_fold(
     let dir = tempfile::tempdir().unwrap();
     for (name, most) in [
         ("bone.ply", 0.03),
-        ("airplane.obj", 0.07),
-        ("cow.obj", 0.20),
+        ("airplane.obj", 0.04),
+        ("cow.obj", 0.12),
     ] {
         let out = ntori()
             .arg("fit")
