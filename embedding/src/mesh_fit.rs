@@ -671,8 +671,9 @@ fn resample(lifts: &Lifts, positions: &[Point3], samples: &[Point3]) -> Vec<Comp
         .collect()
 }
 
-/// Edges longer than this many times the mesh's shorter edges (the lower quartile of the lengths)
-/// are split before the map and the fit ([`split_long_edges`]).
+/// Edges longer than this many times the mesh's shorter edges (the lower quartile of the lengths),
+/// and than [`SPLIT_FROM`] of its bounding-box diagonal, are split before the map and the fit
+/// ([`split_long_edges`]).
 ///
 /// The lower quartile, not the median, is the mesh's own spacing where it is sampled: a CAD
 /// tessellation's long edges (its faces' needles) can be most of its edges, and a mesh made as a
@@ -681,6 +682,14 @@ fn resample(lifts: &Lifts, positions: &[Point3], samples: &[Point3]) -> Vec<Comp
 /// torus, CGAL's knot, `eight.off`, pymeshlab's bone and airplane, and 19.5 and 24.1 times on
 /// CGAL's `pinion.off` and `3torus-smooth.off` (26% and 24% of their edges split).
 pub const LONG_EDGE_FACTOR: f64 = 3.0;
+
+/// No edge shorter than this fraction of the mesh's bounding-box diagonal is split. Marching
+/// cubes and tetrahedra leave slivers whose short edges pull the lower quartile down: 46% of the
+/// raw marching-tetrahedra cube with tunnels' edges are longer than 3 times it, though none is
+/// longer than 4.7% of its diagonal, and split, its map spread 10 360 vertices into 25 660 and
+/// its fit went 57% off. A CAD part's needles span a good part of it (the pinion's up to 34%,
+/// the gear asset's 25%).
+pub const SPLIT_FROM: f64 = 0.05;
 
 /// A user's mesh with its long edges split (see [`mesh::refine`]): the same surface, sampled by
 /// vertices about as densely everywhere.
@@ -694,8 +703,8 @@ pub struct SplitMesh {
 }
 
 /// `positions`, `triangles` with every edge longer than [`LONG_EDGE_FACTOR`] times the lower
-/// quartile of the edges' lengths split at its midpoint (longest first), or `None` where no edge
-/// is that long. At most [`crate::fit::MAX_FIT_TRIANGLES`] / 2 vertices in all.
+/// quartile of the edges' lengths and [`SPLIT_FROM`] of the diagonal split at its midpoint
+/// (longest first), or `None` where no edge is that long. At most [`crate::fit::MAX_FIT_TRIANGLES`] / 2 vertices in all.
 pub fn split_long_edges(positions: &[Point3], triangles: &[[u32; 3]]) -> Option<SplitMesh> {
     let mut lengths: Vec<f64> = triangles
         .iter()
@@ -708,7 +717,7 @@ pub fn split_long_edges(positions: &[Point3], triangles: &[[u32; 3]]) -> Option<
     }
     let quarter = lengths.len() / 4;
     let lower_quartile = *lengths.select_nth_unstable_by(quarter, f64::total_cmp).1;
-    let limit = LONG_EDGE_FACTOR * lower_quartile;
+    let limit = (LONG_EDGE_FACTOR * lower_quartile).max(SPLIT_FROM * diagonal(positions));
     let raw: Vec<[f64; 3]> = positions.iter().map(|p| [p.x, p.y, p.z]).collect();
     let cap = (crate::fit::MAX_FIT_TRIANGLES / 2).max(positions.len());
     let refined = mesh::refine::split_long_edges(&raw, triangles, limit, cap);
