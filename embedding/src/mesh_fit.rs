@@ -41,7 +41,7 @@ use crate::harmonic::Convergence;
 use crate::quality;
 use crate::sphere_map::{EXTRA_ROUNDS, sphere_map};
 use crate::spline_surface::Surface;
-use crate::surface::{Layout, Point3, SplineSettings};
+use crate::surface::{Layout, Point3, SplineSettings, Vector3};
 
 /// Rounds of evening a user's mesh out for its map where the settings do not say
 /// ([`FitSettings::even_rounds`]). Each moves a vertex halfway to its neighbours' centroid; on the
@@ -353,50 +353,73 @@ pub const ROUGHNESS_SAMPLES: u32 = 16;
 /// How far a fitted surface is from what `ntori fit`'s checks accept, measured cheaply (at the
 /// t = [`ROUGHNESS_SAMPLES`] tessellation's vertices and the mesh's own): its largest |κ| against
 /// the mesh's ([`quality::CURVATURE_RATIO_TOLERANCE_MESH`]), its patches' disagreement
-/// ([`quality::DISAGREEMENT_TOLERANCE`]) and its largest distance from the mesh's vertices
-/// ([`quality::RESIDUAL_TOLERANCE`]), which smoothing trades against the other two.
+/// ([`quality::DISAGREEMENT_TOLERANCE`]), its normals against the mesh's at the 90th percentile
+/// ([`quality::NORMAL_TOLERANCE_MESH`]: ringing beside a sharp edge shows there) and its largest
+/// distance from the mesh's vertices ([`quality::RESIDUAL_TOLERANCE`]), which smoothing trades
+/// against the others.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Roughness {
     /// The surface's largest |κ| over the mesh's.
     pub curvature_ratio: f64,
-    /// The largest disagreement of two patches, and the largest residual, as fractions of the
-    /// mesh's diagonal.
+    /// The largest disagreement of two patches, as a fraction of the mesh's diagonal.
     pub disagreement: f64,
+    /// The 90th percentile of the angle (degrees) between the surface's normals and the mesh's
+    /// at its vertices.
+    pub normals_p90: f64,
+    /// The largest residual, as a fraction of the mesh's diagonal.
     pub residual: f64,
 }
 
+/// What [`Roughness::measure`] compares a surface with: the data and the mesh's own normals and
+/// largest |κ|.
+struct Reference<'a> {
+    points: &'a [ChartPoint],
+    positions: &'a [Point3],
+    normals: Vec<Vector3>,
+    curvature: f64,
+    diagonal: f64,
+}
+
 impl Roughness {
-    fn measure(
-        surface: &Surface,
-        data: (&[ChartPoint], &[Point3]),
-        input_curvature: f64,
-        diagonal: f64,
-    ) -> Result<Roughness, EmbeddingError> {
-        let points = quality::sample_points(surface, ROUGHNESS_SAMPLES)?;
-        let largest = quality::max_principal_curvature(surface, &points).max_abs;
-        let disagreement = quality::patch_disagreement(surface, &points, 0.1).max;
+    fn measure(surface: &Surface, reference: &Reference) -> Result<Roughness, EmbeddingError> {
+        let samples = quality::sample_points(surface, ROUGHNESS_SAMPLES)?;
+        let largest = quality::max_principal_curvature(surface, &samples).max_abs;
+        let disagreement = quality::patch_disagreement(surface, &samples, 0.1).max;
+        let normals = quality::normal_deviation_from(surface, reference.points, &reference.normals);
+        let residual = largest_residual(surface, reference.points, reference.positions);
         Ok(Roughness {
-            curvature_ratio: largest / input_curvature,
-            disagreement: disagreement / diagonal,
-            residual: largest_residual(surface, data.0, data.1) / diagonal,
+            curvature_ratio: largest / reference.curvature,
+            disagreement: disagreement / reference.diagonal,
+            normals_p90: normals.p90,
+            residual: residual / reference.diagonal,
         })
+    }
+
+    /// Each measure as a multiple of its tolerance (at most 1 passes); a non-finite measure (a
+    /// degenerate surface) is as bad as it gets.
+    fn excesses(&self) -> [f64; 4] {
+        [
+            self.curvature_ratio / quality::CURVATURE_RATIO_TOLERANCE_MESH,
+            self.disagreement / quality::DISAGREEMENT_TOLERANCE,
+            self.normals_p90 / quality::NORMAL_TOLERANCE_MESH,
+            self.residual / quality::RESIDUAL_TOLERANCE,
+        ]
+        .map(|e| if e.is_nan() { f64::INFINITY } else { e })
     }
 
     /// The largest of the measures as a multiple of its tolerance: at most 1 passes.
     pub fn excess(&self) -> f64 {
-        let excess = [
-            self.curvature_ratio / quality::CURVATURE_RATIO_TOLERANCE_MESH,
-            self.disagreement / quality::DISAGREEMENT_TOLERANCE,
-            self.residual / quality::RESIDUAL_TOLERANCE,
-        ]
-        .into_iter()
-        .fold(0.0, f64::max);
-        // A non-finite measure (a degenerate surface) is as bad as it gets.
-        if excess.is_nan() {
-            f64::INFINITY
-        } else {
-            excess
-        }
+        self.excesses().into_iter().fold(0.0, f64::max)
+    }
+
+    /// How many measures are over their tolerance.
+    pub fn failures(&self) -> usize {
+        self.excesses().into_iter().filter(|&e| e > 1.0).count()
+    }
+
+    /// Rougher than `other`: more measures fail, or as many and the worst is further over.
+    fn worse_than(&self, other: &Roughness) -> bool {
+        (self.failures(), self.excess()) > (other.failures(), other.excess())
     }
 }
 
@@ -433,7 +456,8 @@ impl SmoothnessReport {
 /// The fit through the mesh's vertices at `points` with `fit_settings`'s λ, and, where
 /// [`FitSettings::raise_smoothness`] says so and that surface is rough (its [`Roughness`] fails),
 /// again with λ raised [`SMOOTHNESS_STEP`]-fold at a time up to [`MAX_RAISED_SMOOTHNESS`] until
-/// one passes; the first that passes is kept, else the least rough.
+/// one passes; the first that passes is kept, else the one with the fewest measures failing (of
+/// those, the least far over).
 ///
 /// Why: a smooth surface cannot follow a sharp edge. Through the vertices on both sides of one
 /// (a CAD part's rims, a gear's teeth) the default λ rings: CGAL's `pinion.off` (its long edges
@@ -473,19 +497,24 @@ fn smooth_enough(
         return Ok((surface, report));
     }
     let normals = quality::vertex_normals(positions, triangles);
-    let input_curvature = quality::mesh_max_principal_curvature(positions, triangles, &normals);
-    let data = (points, positions);
-    let roughness = Roughness::measure(&surface, data, input_curvature, diagonal)?;
+    let reference = Reference {
+        points,
+        positions,
+        curvature: quality::mesh_max_principal_curvature(positions, triangles, &normals),
+        normals,
+        diagonal,
+    };
+    let roughness = Roughness::measure(&surface, &reference)?;
     let mut best = (surface, asked, roughness);
     report.tried.push((asked, best.2));
     let mut smoothness = asked;
     while best.2.excess() > 1.0 && smoothness < MAX_RAISED_SMOOTHNESS {
         smoothness = (smoothness * SMOOTHNESS_STEP).min(MAX_RAISED_SMOOTHNESS);
         let surface = fit_with(smoothness)?;
-        let roughness = Roughness::measure(&surface, data, input_curvature, diagonal)?;
+        let roughness = Roughness::measure(&surface, &reference)?;
         report.tried.push((smoothness, roughness));
         tracing::debug!(smoothness, ?roughness, "raised the fit's smoothness");
-        if roughness.excess() < best.2.excess() || roughness.excess() <= 1.0 {
+        if best.2.worse_than(&roughness) {
             best = (surface, smoothness, roughness);
         }
     }

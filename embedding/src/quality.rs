@@ -47,6 +47,10 @@ pub const DISAGREEMENT_TOLERANCE: f64 = 0.01;
 /// `assets/meshes/plate-genus-3.obj` reads 3.1 against its shape's 4.0). Against a shape's exact
 /// normals (`ntori new`) the check takes 3.
 pub const CURVATURE_RATIO_TOLERANCE_MESH: f64 = 4.0;
+/// Largest 90th percentile of a surface's normals' deviation (degrees) from its input mesh's that
+/// `ntori fit` accepts. The mesh's normals carry its faceting; against a shape's exact normals
+/// (`ntori new`) the check takes 5°.
+pub const NORMAL_TOLERANCE_MESH: f64 = 15.0;
 
 /// Points spread over the whole surface: the vertices of its t × t tessellation.
 pub fn sample_points(surface: &Surface, t: u32) -> Result<Vec<ChartPoint>, EmbeddingError> {

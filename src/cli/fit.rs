@@ -35,9 +35,10 @@ use super::{FitArgs, FitProgress};
 /// and scanners make) is also mapped evened out along its own surface, a map that does not follow
 /// the triangles' directions; the fit's data stay the mesh's own vertices, and the map whose fit
 /// comes closer to them is kept. Where the fit at the default smoothness is rough by the checks
-/// (|κ| over 4× the mesh's, patches over 1% apart, a residual over 1%: a smooth surface rings
-/// beside sharp edges), it is fitted again with λ five times larger, up to 1, and the first that
-/// passes, else the least rough, is kept; --smoothness fixes λ. If a check
+/// (|κ| over 4× the mesh's, patches over 1% apart, normals over 15° off at the 90th percentile, a
+/// residual over 1%: a smooth surface rings beside sharp edges), it is fitted again with λ five
+/// times larger, up to 1, and the first that passes, else the one with the fewest failing, is
+/// kept; --smoothness fixes λ. If a check
 /// fails, no model is written (unless --keep-failed) and the exit status is 3. A genus-0 mesh is
 /// mapped onto the sphere instead (no loops); where the relaxation there leaves long limbs
 /// squeezed, the map is made again in rounds of planar solves that even its area out.
@@ -469,15 +470,20 @@ fn smoothness_text(report: &SmoothnessReport) -> String {
     }
     let largest = report.tried.last().map_or(report.used, |t| t.0);
     format!(
-        "smoothness: λ raised from {asked} to {} (tried up to {largest}): at {asked} the surface's \
-         largest |κ| was {:.2}× the mesh's and its patches {:.3}% of the diagonal apart, at {} \
-         {:.2}× and {:.3}% (t = {})\n",
+        "smoothness: λ raised from {asked} to {} (tried up to {largest}; measured at t = {}): at \
+         {asked} the surface's largest |κ| was {:.2}× the mesh's, its patches {:.3}% of the \
+         diagonal apart, its normals {:.1}° off the mesh's (90%) and its residual {:.3}%; at {}, \
+         {:.2}×, {:.3}%, {:.1}° and {:.3}%\n",
         report.used,
+        embedding::mesh_fit::ROUGHNESS_SAMPLES,
         first.curvature_ratio,
         100.0 * first.disagreement,
+        first.normals_p90,
+        100.0 * first.residual,
         report.used,
         last.curvature_ratio,
         100.0 * last.disagreement,
-        embedding::mesh_fit::ROUGHNESS_SAMPLES,
+        last.normals_p90,
+        100.0 * last.residual,
     )
 }

@@ -385,7 +385,7 @@ pub const CURVATURE_RATIO_TOLERANCE_MESH: f64 = embedding::quality::CURVATURE_RA
 /// Largest 90th percentile of the normal deviation (degrees) the check accepts, against the
 /// intended shape's exact normals and against a mesh's own (which carry its faceting).
 pub const NORMAL_TOLERANCE_INTENDED: f64 = 5.0;
-pub const NORMAL_TOLERANCE_MESH: f64 = 15.0;
+pub const NORMAL_TOLERANCE_MESH: f64 = embedding::quality::NORMAL_TOLERANCE_MESH;
 
 /// A fitted model and what it was fitted to, for [`check`].
 pub struct Fitted<'a> {
