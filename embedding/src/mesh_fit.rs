@@ -754,6 +754,9 @@ pub fn split_long_edges(positions: &[Point3], triangles: &[[u32; 3]]) -> Option<
     let raw: Vec<[f64; 3]> = positions.iter().map(|p| [p.x, p.y, p.z]).collect();
     let cap = (crate::fit::MAX_FIT_TRIANGLES / 2).max(positions.len());
     let refined = mesh::refine::split_long_edges(&raw, triangles, limit, cap);
+    if refined.capped {
+        tracing::warn!(limit, cap, "long edges left: splitting them stopped at the vertex cap");
+    }
     (refined.added > 0).then(|| SplitMesh {
         positions: refined.positions.into_iter().map(Point3::from).collect(),
         triangles: refined.triangles,
