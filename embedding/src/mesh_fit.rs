@@ -723,6 +723,13 @@ pub const LONG_EDGE_FACTOR: f64 = 3.0;
 /// the gear asset's 25%).
 pub const SPLIT_FROM: f64 = 0.05;
 
+/// Edges longer than this fraction of the mesh's bounding-box diagonal are split however many
+/// there are: a mesh whose edges are all long (a box of 12 triangles) has no finer spacing of its
+/// own to go by, and through its 8 vertices alone the fit's patches came 62% of the diagonal apart
+/// and the surface 44% from the box. The longest edge of every smooth mesh at hand is under 11.4%
+/// of its diagonal (CGAL's 231-vertex `double-torus-example.off`), so none of them is split.
+pub const SPLIT_ALWAYS_FROM: f64 = 0.12;
+
 /// A user's mesh with its long edges split (see [`mesh::refine`]): the same surface, sampled by
 /// vertices about as densely everywhere.
 #[derive(Clone, Debug)]
@@ -735,8 +742,9 @@ pub struct SplitMesh {
 }
 
 /// `positions`, `triangles` with every edge longer than [`LONG_EDGE_FACTOR`] times the lower
-/// quartile of the edges' lengths and [`SPLIT_FROM`] of the diagonal split at its midpoint
-/// (longest first), or `None` where no edge is that long. At most
+/// quartile of the edges' lengths and [`SPLIT_FROM`] of the diagonal, or than
+/// [`SPLIT_ALWAYS_FROM`] of it, split at its midpoint (longest first), or `None` where no edge is
+/// that long. At most
 /// [`crate::fit::MAX_FIT_TRIANGLES`] / 2 vertices in all.
 pub fn split_long_edges(positions: &[Point3], triangles: &[[u32; 3]]) -> Option<SplitMesh> {
     let mut lengths: Vec<f64> = triangles
@@ -750,12 +758,19 @@ pub fn split_long_edges(positions: &[Point3], triangles: &[[u32; 3]]) -> Option<
     }
     let quarter = lengths.len() / 4;
     let lower_quartile = *lengths.select_nth_unstable_by(quarter, f64::total_cmp).1;
-    let limit = (LONG_EDGE_FACTOR * lower_quartile).max(SPLIT_FROM * diagonal(positions));
+    let diagonal = diagonal(positions);
+    let limit = (LONG_EDGE_FACTOR * lower_quartile)
+        .max(SPLIT_FROM * diagonal)
+        .min(SPLIT_ALWAYS_FROM * diagonal);
     let raw: Vec<[f64; 3]> = positions.iter().map(|p| [p.x, p.y, p.z]).collect();
     let cap = (crate::fit::MAX_FIT_TRIANGLES / 2).max(positions.len());
     let refined = mesh::refine::split_long_edges(&raw, triangles, limit, cap);
     if refined.capped {
-        tracing::warn!(limit, cap, "long edges left: splitting them stopped at the vertex cap");
+        tracing::warn!(
+            limit,
+            cap,
+            "long edges left: splitting them stopped at the vertex cap"
+        );
     }
     (refined.added > 0).then(|| SplitMesh {
         positions: refined.positions.into_iter().map(Point3::from).collect(),

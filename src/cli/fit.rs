@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 use embedding::fit::FitStage;
 use embedding::mesh_fit::{
-    LONG_EDGE_FACTOR, MeshFit, SPLIT_FROM, SmoothnessReport, UserMeshFit, fit_user_mesh,
-    mesh_fit_disk_grid, mesh_fit_grid, mesh_model,
+    LONG_EDGE_FACTOR, MeshFit, SPLIT_ALWAYS_FROM, SPLIT_FROM, SmoothnessReport, UserMeshFit,
+    fit_user_mesh, mesh_fit_disk_grid, mesh_fit_grid, mesh_model,
 };
 use ntori::io::import::{self, ValidMesh, cage};
 use serde::Serialize;
@@ -22,8 +22,8 @@ use super::{FitArgs, FitProgress};
 /// none) and checked: one closed, consistently oriented manifold without degenerate triangles, or
 /// an error that says what is wrong and where. Its genus comes from its Euler characteristic.
 /// Edges longer than three times the mesh's lower-quartile edge and 5% of its diagonal (a CAD
-/// tessellation's needles) are split at their midpoints, so the fit sees the faces they span; the
-/// surface stays where it is.
+/// tessellation's needles), or than 12% of it, are split at their midpoints, so the fit sees the
+/// faces they span; the surface stays where it is.
 ///
 /// A system of 2g loops through one vertex is grown (a shortest-path tree and its dual), the
 /// relation the loops satisfy is brought to the canonical form a₁ b₁ a₁⁻¹ b₁⁻¹ …, and every edge
@@ -309,7 +309,7 @@ struct InputReport {
 struct SplitReport {
     added_vertices: usize,
     /// No edge is longer than this now (model units): `LONG_EDGE_FACTOR` times the lower quartile,
-    /// or `SPLIT_FROM` of the diagonal if that is longer.
+    /// kept within `SPLIT_FROM` to `SPLIT_ALWAYS_FROM` of the diagonal.
     longest_edge: f64,
 }
 
@@ -441,10 +441,11 @@ impl Report for FitReport<'_> {
         let split = i.split.as_ref().map_or(split_failed, |s| {
             format!(
                 "long edges: split at their midpoints until none is longer than {:.4} ({LONG_EDGE_FACTOR}× \
-                 the lower-quartile edge, or {}% of the diagonal if longer), {} vertices added, so the \
-                 fit sees the faces they spanned\n",
+                 the lower-quartile edge, kept within {}% to {}% of the diagonal), {} vertices added, \
+                 so the fit sees the faces they spanned\n",
                 s.longest_edge,
                 100.0 * SPLIT_FROM,
+                100.0 * SPLIT_ALWAYS_FROM,
                 s.added_vertices
             )
         });
