@@ -168,7 +168,7 @@ pub fn surface_smoothness(genus: u32) -> bool {
 pub struct MeshFit {
     pub surface: Surface,
     pub genus: u32,
-    /// The smoothness weight the fit used ([`smooth_enough`]).
+    /// The smoothness weight the fit used, and why (`smooth_enough`).
     pub smoothness: SmoothnessReport,
     /// The mesh's vertices' surface points (one per vertex), the relaxation's sweeps and folds.
     pub parameterization: Parameterization,
@@ -342,9 +342,10 @@ fn finish(
     })
 }
 
-/// Each step of [`smooth_enough`]'s ladder multiplies λ by this.
+/// Each step of the fit's smoothness ladder (see [`FitSettings::raise_smoothness`]) multiplies λ
+/// by this.
 pub const SMOOTHNESS_STEP: f64 = 5.0;
-/// The largest λ [`smooth_enough`] raises the smoothness to (its last step is cut to it).
+/// The largest λ the ladder raises the smoothness to (its last step is cut to it).
 pub const MAX_RAISED_SMOOTHNESS: f64 = 1.0;
 /// Tessellation of the points where [`Roughness`] is measured (`ntori fit`'s shape checks use the
 /// same).
