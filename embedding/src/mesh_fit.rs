@@ -441,7 +441,14 @@ pub struct SmoothnessReport {
     pub asked: f64,
     pub used: f64,
     /// Each λ tried (from `asked`) and its surface's roughness.
-    pub tried: Vec<(f64, Roughness)>,
+    pub tried: Vec<Tried>,
+}
+
+/// One λ [`SmoothnessReport`] tried, and how rough its surface was.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Tried {
+    pub smoothness: f64,
+    pub roughness: Roughness,
 }
 
 impl SmoothnessReport {
@@ -449,8 +456,8 @@ impl SmoothnessReport {
     pub fn passed(&self) -> bool {
         self.tried
             .iter()
-            .find(|(smoothness, _)| *smoothness == self.used)
-            .is_none_or(|(_, roughness)| roughness.excess() <= 1.0)
+            .find(|t| t.smoothness == self.used)
+            .is_none_or(|t| t.roughness.excess() <= 1.0)
     }
 }
 
@@ -510,13 +517,19 @@ fn smooth_enough(
     };
     let roughness = Roughness::measure(&surface, &reference)?;
     let mut best = (surface, asked, roughness);
-    report.tried.push((asked, best.2));
+    report.tried.push(Tried {
+        smoothness: asked,
+        roughness,
+    });
     let mut smoothness = asked;
     while best.2.excess() > 1.0 && smoothness < MAX_RAISED_SMOOTHNESS {
         smoothness = (smoothness * SMOOTHNESS_STEP).min(MAX_RAISED_SMOOTHNESS);
         let surface = fit_with(smoothness)?;
         let roughness = Roughness::measure(&surface, &reference)?;
-        report.tried.push((smoothness, roughness));
+        report.tried.push(Tried {
+            smoothness,
+            roughness,
+        });
         tracing::debug!(smoothness, ?roughness, "raised the fit's smoothness");
         if best.2.worse_than(&roughness) {
             best = (surface, smoothness, roughness);

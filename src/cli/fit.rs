@@ -460,16 +460,17 @@ impl Report for FitReport<'_> {
 
 /// The line saying that λ was raised, and why (nothing where the first λ passed or none was tried).
 fn smoothness_text(report: &SmoothnessReport) -> String {
-    let (Some((asked, first)), Some((_, last))) = (
+    let (Some(first), Some(kept)) = (
         report.tried.first(),
-        report.tried.iter().find(|(l, _)| *l == report.used),
+        report.tried.iter().find(|t| t.smoothness == report.used),
     ) else {
         return String::new();
     };
     if report.used == report.asked {
         return String::new();
     }
-    let largest = report.tried.last().map_or(report.used, |t| t.0);
+    let (asked, first, last) = (first.smoothness, first.roughness, kept.roughness);
+    let largest = report.tried.last().map_or(report.used, |t| t.smoothness);
     format!(
         "smoothness: λ raised from {asked} to {} (tried up to {largest}; measured at t = {}): at \
          {asked} the surface's largest |κ| was {:.2}× the mesh's, its patches {:.3}% of the \

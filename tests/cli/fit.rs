@@ -75,6 +75,16 @@ fn a_cad_mesh_has_its_long_edges_split_and_its_smoothness_raised() {
         smoothness["used"].as_f64().unwrap(),
     );
     assert!(used > asked, "{smoothness}");
+    // Each λ tried, from the default on, with the four measures that decided.
+    let tried = smoothness["tried"].as_array().unwrap();
+    assert_eq!(tried[0]["smoothness"].as_f64(), Some(asked));
+    assert!(tried.iter().any(|t| t["smoothness"].as_f64() == Some(used)));
+    for measure in ["curvature_ratio", "disagreement", "normals_p90", "residual"] {
+        assert!(
+            tried[0]["roughness"][measure].is_number(),
+            "{measure}: {smoothness}"
+        );
+    }
     let fit = &report["fit"];
     assert_eq!(
         (fit["genus"].as_u64(), fit["folded_triangles"].as_u64()),
