@@ -230,12 +230,20 @@ pub fn mesh_model(
     let atlas = Arc::new(Atlas::new(genus)?);
     let layout = Layout::new(&atlas, settings)?;
     let areas = vertex_areas(positions, triangles);
+    // What a raised λ's surface is compared with (`smooth_enough`): made once for either map.
+    let own_shape = fit_settings.raise_smoothness.then(|| {
+        let normals = quality::vertex_normals(positions, triangles);
+        OwnShape {
+            curvature: quality::mesh_max_principal_curvature(positions, triangles, &normals),
+            normals,
+        }
+    });
     let input = MeshInput {
         atlas: &atlas,
         layout: &layout,
         genus,
         positions,
-        triangles,
+        own_shape: own_shape.as_ref(),
         areas: &areas,
     };
     let Some(polygon) = atlas.polygon() else {
@@ -290,8 +298,15 @@ struct MeshInput<'a> {
     layout: &'a Layout<'a>,
     genus: u32,
     positions: &'a [Point3],
-    triangles: &'a [[u32; 3]],
+    /// The mesh's own normals and largest |κ|, where λ may be raised.
+    own_shape: Option<&'a OwnShape>,
     areas: &'a [f64],
+}
+
+/// A mesh's vertex normals ([`quality::vertex_normals`]) and its largest |κ| estimated with them.
+struct OwnShape {
+    normals: Vec<Vector3>,
+    curvature: f64,
 }
 
 /// The least-squares fit through the mesh's vertices at the map's points, and its residual.
@@ -376,8 +391,7 @@ pub struct Roughness {
 struct Reference<'a> {
     points: &'a [ChartPoint],
     positions: &'a [Point3],
-    normals: Vec<Vector3>,
-    curvature: f64,
+    own: &'a OwnShape,
     diagonal: f64,
 }
 
@@ -386,10 +400,11 @@ impl Roughness {
         let samples = quality::sample_points(surface, ROUGHNESS_SAMPLES)?;
         let largest = quality::max_principal_curvature(surface, &samples).max_abs;
         let disagreement = quality::patch_disagreement(surface, &samples, 0.1).max;
-        let normals = quality::normal_deviation_from(surface, reference.points, &reference.normals);
+        let normals =
+            quality::normal_deviation_from(surface, reference.points, &reference.own.normals);
         let residual = largest_residual(surface, reference.points, reference.positions);
         Ok(Roughness {
-            curvature_ratio: largest / reference.curvature,
+            curvature_ratio: largest / reference.own.curvature,
             disagreement: disagreement / reference.diagonal,
             normals_p90: normals.p90,
             residual: residual / reference.diagonal,
@@ -485,7 +500,7 @@ fn smooth_enough(
         atlas,
         layout,
         positions,
-        triangles,
+        own_shape,
         areas,
         ..
     } = *input;
@@ -504,15 +519,13 @@ fn smooth_enough(
         used: asked,
         tried: Vec::new(),
     };
-    if !fit_settings.raise_smoothness {
+    let Some(own) = own_shape else {
         return Ok((surface, report));
-    }
-    let normals = quality::vertex_normals(positions, triangles);
+    };
     let reference = Reference {
         points,
         positions,
-        curvature: quality::mesh_max_principal_curvature(positions, triangles, &normals),
-        normals,
+        own,
         diagonal,
     };
     let roughness = Roughness::measure(&surface, &reference)?;

@@ -308,14 +308,22 @@ pub fn hausdorff_to_mesh(
     positions: &[Point3],
     triangles: &[[u32; 3]],
 ) -> Result<mesh::spatial::Hausdorff, EmbeddingError> {
-    let (surface_positions, surface_triangles) = tessellated(surface, t)?;
     let input: Vec<[f64; 3]> = positions.iter().map(|p| p.coords.into()).collect();
+    hausdorff_between(&tessellated(surface, t)?, &input, triangles)
+}
+
+/// [`mesh::spatial::hausdorff`] between a tessellation and a mesh as plain arrays.
+fn hausdorff_between(
+    (surface_positions, surface_triangles): &PlainMesh,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+) -> Result<mesh::spatial::Hausdorff, EmbeddingError> {
     let a = mesh::spatial::MeshRef {
-        positions: &surface_positions,
-        triangles: &surface_triangles,
+        positions: surface_positions,
+        triangles: surface_triangles,
     };
     let b = mesh::spatial::MeshRef {
-        positions: &input,
+        positions,
         triangles,
     };
     Ok(mesh::spatial::hausdorff(a, b)?)
@@ -352,20 +360,12 @@ pub fn hausdorff_to_mesh_resolved(
             longest /= 2.0;
         }
     }
-    let (surface_positions, surface_triangles) = if t == coarsest {
+    let tessellation = if t == coarsest {
         coarse
     } else {
         tessellated(surface, t)?
     };
-    let a = mesh::spatial::MeshRef {
-        positions: &surface_positions,
-        triangles: &surface_triangles,
-    };
-    let b = mesh::spatial::MeshRef {
-        positions: &input,
-        triangles,
-    };
-    Ok((mesh::spatial::hausdorff(a, b)?, t))
+    Ok((hausdorff_between(&tessellation, &input, triangles)?, t))
 }
 
 /// The most vertices [`hausdorff_to_mesh_resolved`] lets the tessellation have (genus 1 at 128
