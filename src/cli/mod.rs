@@ -96,8 +96,9 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct FitArgs {
     /// Control points per side of each chart's grid [default: for new 32 up to genus 2 and 48 from
-    /// genus 3 (a coarser grid ripples there); 40 for fit; 32 for fit --cage]
-    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=64))]
+    /// genus 3 (a coarser grid ripples there); for fit 40, and 80 for a genus-0 mesh (its two
+    /// charts carry the whole surface); 32 for fit --cage]
+    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=MAX_GRID))]
     grid: Option<u64>,
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
@@ -151,6 +152,11 @@ impl FitArgs {
         (spline, fit)
     }
 }
+
+/// The largest `--grid`: twice what `fit` gives a genus-0 mesh by default (a finer grid is what
+/// brings a sphere's two charts closer to a detailed mesh), and beyond any grid the other genera
+/// need (their disk charts have a grid of their own).
+const MAX_GRID: u64 = 160;
 
 /// The largest smoothness weight accepted: beyond it the least-squares system is the smoothness
 /// term alone to f64 precision (λ = 1e308 overflowed into non-finite control points).
