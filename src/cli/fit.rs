@@ -123,6 +123,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             mesh_fit_disk_grid(valid.genus, grid)
         })
     };
+    super::check_grid_size(valid.genus, &settings)?;
     fit.even_rounds = args.even_rounds as usize;
     fit.surface_smoothness = embedding::mesh_fit::surface_smoothness(valid.genus);
     // λ is raised where the default leaves the surface rough, not where the user chose it.

@@ -153,6 +153,27 @@ impl FitArgs {
     }
 }
 
+/// The most control points a fit is given: what the grids' old limits (64, and 512 for the disk
+/// charts) made at genus 64. `--grid` now goes further for the few charts of low genus, not for
+/// the 130 charts of genus 64, whose fit would take hours and many gigabytes.
+const MAX_CONTROL_POINTS: usize = 1 << 20;
+
+/// Refuses spline settings whose grids at `genus` hold more than [`MAX_CONTROL_POINTS`], before
+/// any work: every genus has two disk charts and 2·genus square ones.
+fn check_grid_size(genus: u32, settings: &SplineSettings) -> anyhow::Result<()> {
+    let disk = settings.disk_grid.unwrap_or(settings.grid);
+    let count = 2 * disk * disk + 2 * genus as usize * settings.grid * settings.grid;
+    if count > MAX_CONTROL_POINTS {
+        anyhow::bail!(
+            "a grid of {} ({} in the disk charts) at genus {genus} makes {count} control points, \
+             more than the {MAX_CONTROL_POINTS} a fit takes; choose a coarser --grid or --disk-grid",
+            settings.grid,
+            disk
+        );
+    }
+    Ok(())
+}
+
 /// The largest `--grid`: twice what `fit` gives a genus-0 mesh by default (a finer grid is what
 /// brings a sphere's two charts closer to a detailed mesh), and beyond any grid the other genera
 /// need (their disk charts have a grid of their own).

@@ -88,6 +88,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (settings, fit) = spline.settings(embedding::fit::default_grid(genus), |grid| {
         embedding::fit::default_disk_grid(genus, grid)
     });
+    super::check_grid_size(genus, &settings)?;
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;

@@ -56,6 +56,17 @@ fn new_rejects_impossible_parameters() {
             .stderr(predicate::str::is_empty().not());
         assert!(!path.exists(), "{args:?} left a file");
     }
+    // A grid a sphere may have is refused at genus 64, at once and by its size.
+    ntori()
+        .args(["new", "--genus", "64", "--grid", "160", "-o"])
+        .arg(&path)
+        .timeout(std::time::Duration::from_secs(30))
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains(
+            "a grid of 160 (1280 in the disk charts) at genus 64 makes 6553600 control points",
+        ));
+    assert!(!path.exists());
 }
 
 #[test]
