@@ -14,10 +14,11 @@ use super::write_stdout;
 /// a₁ b₁ a₂ b₂ on the surface, PNG), figure 3 (the hyperbolic polygon with ω, h, r, γ, α, β),
 /// figure 4 (the three chart kinds, in their coordinates and in the polygon), figure 5 (the
 /// overlap regions), figure 6 (the input mesh, the fitted surface, two edited surfaces; PNG),
-/// figure 7 (the tessellation), a gallery (genus 0 to 6, 8, 10 and 16 shaded; genus 3, 5, 10 and
-/// 16 in mean curvature; genus 2 in the chart and curvature styles; PNG), and CAPTIONS.md listing
-/// every file with what it shows and the parameters that made it. The 2D figures are for genus 2,
-/// like the paper's. The gallery's fits and pictures take about a minute on two cores (1.5 GB).
+/// figure 7 (the tessellation), a gallery (genus 0 to 6, 8, 10, 16 and 32 shaded; genus 3, 5, 10,
+/// 16 and 32 in mean curvature; genus 2 in the chart and curvature styles; PNG), and CAPTIONS.md
+/// listing every file with what it shows and the parameters that made it. The 2D figures are for
+/// genus 2, like the paper's. The gallery's fits and pictures take about a minute and a quarter on
+/// two cores, half of it for genus 32, and 3 GB.
 ///
 /// The PNG figures need a GPU (or a software adapter); without one they are left out with a
 /// warning, and the caption file says so. Running the command again writes the same bytes.

@@ -18,7 +18,7 @@ const SVG: [&str; 6] = [
 ];
 
 /// The PNG figures and their sizes in pixels.
-const PNG: [(&str, u32, u32); 14] = [
+const PNG: [(&str, u32, u32); 16] = [
     ("fig2b-loops.png", 1200, 900),
     ("fig6a-input-mesh.png", 1200, 900),
     ("fig6b-fitted.png", 1200, 900),
@@ -31,6 +31,8 @@ const PNG: [(&str, u32, u32); 14] = [
     ("gallery-genus4.png", 800, 600),
     ("gallery-genus5.png", 800, 600),
     ("gallery-genus6.png", 800, 600),
+    ("gallery-genus32.png", 800, 600),
+    ("gallery-genus32-mean.png", 800, 600),
     ("gallery-genus2-charts.png", 800, 600),
     ("gallery-genus2-gaussian.png", 800, 600),
 ];
