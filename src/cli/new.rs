@@ -85,10 +85,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         quiet,
     } = args;
-    let (settings, fit) = spline.settings(embedding::fit::default_grid(genus), |grid| {
+    let (settings, mut fit) = spline.settings(embedding::fit::default_grid(genus), |grid| {
         embedding::fit::default_disk_grid(genus, grid)
     });
     super::check_grid_size(genus, &settings)?;
+    fit.surface_smoothness = embedding::fit::plate_surface_smoothness(genus, settings.grid);
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;

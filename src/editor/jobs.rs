@@ -109,7 +109,7 @@ impl Jobs {
                 genus,
                 resolution,
                 settings,
-                FitSettings::for_grid(settings.grid),
+                FitSettings::for_plate(genus, settings.grid),
             )
             .map_err(fail)?;
             Ok(JobOutput::NewModel {

@@ -123,11 +123,16 @@ fn fit_parameters(genus: u32, resolution: usize) -> String {
     let (s, f) = default_settings(genus);
     format!(
         "`embedding::fit::initial_model({genus}, {resolution}, …)` with `ntori new`'s defaults \
-         (degree {}, C^{} blends, {}, smoothness {})",
+         (degree {}, C^{} blends, {}, smoothness {}{})",
         s.degree,
         s.continuity,
         s.grid_text(),
-        f.smoothness
+        f.smoothness,
+        if f.surface_smoothness {
+            " in the surface's arc length"
+        } else {
+            ""
+        }
     )
 }
 

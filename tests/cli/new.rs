@@ -162,6 +162,33 @@ fn a_model_that_fails_its_checks_is_written_only_when_asked() {
 }
 
 #[test]
+fn the_default_genus_3_plate_has_fair_rims() {
+    // The smoothness term in arc length (`plate_surface_smoothness`) smooths the swirls of mean
+    // curvature on the eased rims round the holes: measured largest |κ| 1.18× the input's and
+    // normals 0.22° off at the 90th percentile, against 1.32× and 0.29° with the grids' term.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("three.json");
+    let out = ntori()
+        .args(["new", "--genus", "3", "--json", "-q", "-o"])
+        .arg(&path)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let shape = &report["shape"];
+    let ratio = shape["curvature_ratio"].as_f64().unwrap();
+    assert!(ratio < 1.25, "{shape}");
+    let normals = shape["normal_deviation_p90"].as_f64().unwrap();
+    assert!(normals < 0.25, "{shape}");
+    assert!(
+        shape["patch_disagreement"].as_f64().unwrap() < 2e-4,
+        "{shape}"
+    );
+}
+
+#[test]
 fn the_report_measures_the_shape() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sphere.json");

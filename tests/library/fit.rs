@@ -442,7 +442,18 @@ fn the_default_grid_is_32_up_to_genus_2_and_finer_above_with_more_smoothing() {
             let d = SplineSettings::default();
             (d.degree, d.continuity)
         });
-        assert_eq!(fit, FitSettings::for_grid(spline.grid), "genus {genus}");
+        assert_eq!(
+            fit,
+            FitSettings::for_plate(genus, spline.grid),
+            "genus {genus}"
+        );
+        assert_eq!(
+            fit.smoothness,
+            FitSettings::for_grid(spline.grid).smoothness
+        );
+        // The arc-length term up to genus 5 on `new`'s grids, not on the assets' coarse ones.
+        assert_eq!(fit.surface_smoothness, genus <= 5, "genus {genus}");
+        assert!(!FitSettings::for_plate(genus, 16).surface_smoothness);
     }
 }
 
