@@ -479,8 +479,9 @@ pub const PLATE_SURFACE_SMOOTHNESS_UP_TO: u32 = 5;
 /// | 32 | 2.88× → 5.40× (fails `new`'s 3×) | 0.39° → 0.24° | 54 → 66 s |
 ///
 /// Patches and the distance to the input are the same to within 0.01% of the diagonal. From genus
-/// 16 the largest |κ| grows, at peaks on the outer rim where disk charts with coarse rims meet edge
-/// charts; genus 10 gains but its second solve costs 1.7 s, past issue 12's 5 s for a genus-10 fit.
+/// 16 the largest |κ| grows (those peaks were not located); genus 8 does not gain, and genus 10
+/// gains but its second solve costs 1.7 s, past issue 12's 5 s for a genus-10 fit. Genera 6, 7, 9
+/// and 11 to 15 were not measured.
 pub fn plate_surface_smoothness(genus: u32, grid: usize) -> bool {
     genus <= PLATE_SURFACE_SMOOTHNESS_UP_TO && grid >= SplineSettings::default().grid
 }
