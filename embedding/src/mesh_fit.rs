@@ -771,8 +771,7 @@ pub struct SplitMesh {
 /// `positions`, `triangles` with every edge longer than [`LONG_EDGE_FACTOR`] times the lower
 /// quartile of the edges' lengths and [`SPLIT_FROM`] of the diagonal, or than
 /// [`SPLIT_ALWAYS_FROM`] of it, split at its midpoint (longest first), or `None` where no edge is
-/// that long. At most
-/// [`crate::fit::MAX_FIT_TRIANGLES`] / 2 vertices in all.
+/// that long. At most [`crate::fit::MAX_FIT_TRIANGLES`] / 2 vertices in all.
 pub fn split_long_edges(positions: &[Point3], triangles: &[[u32; 3]]) -> Option<SplitMesh> {
     let mut lengths: Vec<f64> = triangles
         .iter()

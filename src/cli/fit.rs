@@ -116,14 +116,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     // 4.5° / 1.6° off its limit normals at the 90th percentile. A user's mesh gets finer disk
     // charts, as `new`'s plates do (`mesh_fit::default_settings` says what was measured).
     let (settings, mut fit) = if cage.is_some() {
-        args.spline
-            .settings(embedding::SplineSettings::default().grid, |_| None)
+        args.spline.settings(
+            valid.genus,
+            embedding::SplineSettings::default().grid,
+            |_| None,
+        )?
     } else {
-        args.spline.settings(mesh_fit_grid(valid.genus), |grid| {
-            mesh_fit_disk_grid(valid.genus, grid)
-        })
+        args.spline
+            .settings(valid.genus, mesh_fit_grid(valid.genus), |grid| {
+                mesh_fit_disk_grid(valid.genus, grid)
+            })?
     };
-    super::check_grid_size(valid.genus, &settings)?;
     fit.even_rounds = args.even_rounds as usize;
     fit.surface_smoothness = embedding::mesh_fit::surface_smoothness(valid.genus);
     // λ is raised where the default leaves the surface rough, not where the user chose it.

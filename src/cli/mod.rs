@@ -124,13 +124,15 @@ struct FitArgs {
 }
 
 impl FitArgs {
-    /// The settings asked for; the grid is `default_grid` where none was given, and the disk
-    /// charts' grid `default_disk_grid` of the grid (`None`: the grid).
+    /// The settings asked for at `genus`; the grid is `default_grid` where none was given, and the
+    /// disk charts' grid `default_disk_grid` of the grid (`None`: the grid). Grids too large for a
+    /// fit are refused here ([`check_grid_size`]), before any work.
     fn settings(
         &self,
+        genus: u32,
         default_grid: usize,
         default_disk_grid: impl Fn(usize) -> Option<usize>,
-    ) -> (SplineSettings, FitSettings) {
+    ) -> anyhow::Result<(SplineSettings, FitSettings)> {
         let grid = self.grid.map_or(default_grid, |g| g as usize);
         let disk_grid = self
             .disk_grid
@@ -143,13 +145,14 @@ impl FitArgs {
             grid,
             disk_grid,
         };
+        check_grid_size(genus, &spline)?;
         let fit = FitSettings {
             smoothness: self
                 .smoothness
                 .unwrap_or_else(|| embedding::fit::default_smoothness(spline.grid)),
             ..FitSettings::default()
         };
-        (spline, fit)
+        Ok((spline, fit))
     }
 }
 
@@ -158,8 +161,8 @@ impl FitArgs {
 /// the 130 charts of genus 64, whose fit would take hours and many gigabytes.
 const MAX_CONTROL_POINTS: usize = 1 << 20;
 
-/// Refuses spline settings whose grids at `genus` hold more than [`MAX_CONTROL_POINTS`], before
-/// any work: every genus has two disk charts and 2·genus square ones.
+/// Refuses spline settings whose grids at `genus` hold more than [`MAX_CONTROL_POINTS`]: every
+/// genus has two disk charts and 2·genus square ones.
 fn check_grid_size(genus: u32, settings: &SplineSettings) -> anyhow::Result<()> {
     let disk = settings.disk_grid.unwrap_or(settings.grid);
     let count = 2 * disk * disk + 2 * genus as usize * settings.grid * settings.grid;

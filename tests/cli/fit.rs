@@ -179,17 +179,17 @@ fn a_genus_zero_fit_takes_a_grid_finer_than_its_default() {
     // make it coarser.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("dumbbell.json");
-    let out = ntori()
-        .arg("fit")
-        .arg(asset("meshes/dumbbell-genus-0.obj"))
-        .args(["--grid", "96", "--json", "-q", "-o"])
-        .arg(&path)
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let mesh = asset("meshes/dumbbell-genus-0.obj");
+    let report = ntori_json(&[
+        "fit".as_ref(),
+        mesh.as_os_str(),
+        "--grid".as_ref(),
+        "96".as_ref(),
+        "--json".as_ref(),
+        "-q".as_ref(),
+        "-o".as_ref(),
+        path.as_os_str(),
+    ]);
     assert_eq!(report["fit"]["settings"]["grid"], 96);
     assert_eq!(report["fit"]["control_points"], 2 * 96 * 96);
     assert_eq!(report["fit"]["passed"], true);

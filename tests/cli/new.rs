@@ -168,15 +168,15 @@ fn the_default_genus_3_plate_has_fair_rims() {
     // normals 0.22° off at the 90th percentile, against 1.32× and 0.29° with the grids' term.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("three.json");
-    let out = ntori()
-        .args(["new", "--genus", "3", "--json", "-q", "-o"])
-        .arg(&path)
-        .assert()
-        .success()
-        .get_output()
-        .stdout
-        .clone();
-    let report: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let report = ntori_json(&[
+        "new".as_ref(),
+        "--genus".as_ref(),
+        "3".as_ref(),
+        "--json".as_ref(),
+        "-q".as_ref(),
+        "-o".as_ref(),
+        path.as_os_str(),
+    ]);
     let shape = &report["shape"];
     let ratio = shape["curvature_ratio"].as_f64().unwrap();
     assert!(ratio < 1.25, "{shape}");
