@@ -7,6 +7,7 @@ use std::time::Instant;
 use embedding::SplineSettings;
 use embedding::fit::{
     FitSettings, default_disk_grid, default_grid, default_smoothness, initial_model,
+    plate_surface_smoothness,
 };
 use embedding::quality::{
     max_principal_curvature, normal_deviation_from, patch_disagreement, sample_points,
@@ -27,7 +28,8 @@ fn main() {
     );
     for genus in genera {
         let start = Instant::now();
-        // NTORI_GRID, NTORI_DISK_GRID, NTORI_PATCH_WEIGHT, NTORI_SMOOTHNESS and NTORI_RESOLUTION
+        // NTORI_GRID, NTORI_DISK_GRID, NTORI_PATCH_WEIGHT, NTORI_SMOOTHNESS, NTORI_RESOLUTION and
+        // NTORI_SURFACE_SMOOTHNESS (1 or 0)
         // override `ntori new`'s defaults, for tuning.
         let defaults = FitSettings::default();
         let setting = |name: &str, default: f64| {
@@ -47,6 +49,10 @@ fn main() {
             smoothness: setting("NTORI_SMOOTHNESS", default_smoothness(spline.grid)),
             stretch_rounds: setting("NTORI_STRETCH_ROUNDS", defaults.stretch_rounds as f64)
                 as usize,
+            surface_smoothness: setting(
+                "NTORI_SURFACE_SMOOTHNESS",
+                f64::from(u8::from(plate_surface_smoothness(genus, spline.grid))),
+            ) != 0.0,
             ..defaults
         };
         let resolution = setting(
@@ -70,6 +76,21 @@ fn main() {
             n.p90,
             n.max
         );
+        if let Some(at) = k.at {
+            let p = s.position(at);
+            let jet = s.eval(at);
+            println!(
+                "       largest |κ| at ({:.3}, {:.3}, {:.3}), radius {:.3}, in chart {:?}; normal z {:.3}",
+                p.x,
+                p.y,
+                p.z,
+                p.x.hypot(p.y),
+                at.chart,
+                jet.normal().z
+            );
+            let blends = s.layout().blends(at);
+            println!("       blends there: {blends:?}");
+        }
         if let Some((p90, h_median, h_p90, count)) = flat {
             println!(
                 "       flat faces ({count} vertices): normal off ±z by {p90:.2}° (90%), |H|·T {h_median:.4} median, {h_p90:.4} (90%)"

@@ -10,13 +10,13 @@
 //!
 //! Here the same energy is taken in the surface's arc length, ∫ |∇²S|² dA, with the metric read
 //! off a first fit. At each interior control point the metric g = [[E, F], [F, G]] comes from the
-//! grid's central first differences (S_u and S_v per grid step), averaged with its neighbours;
+//! first fit's patch derivatives there (S_u and S_v per grid step), averaged with its neighbours;
 //! then with M = g^(-1/2) and H the grid's Hessian (centred second differences), the rows are
 //! the entries of M H M, times the area element's square root. The metric is scaled so that its
 //! median area element is 1, so a uniform isotropic map gives the plain energy back and the
 //! smoothness weight keeps its meaning.
 
-use crate::surface::{Layout, Point3};
+use crate::surface::{Layout, Point3, Vector3};
 
 /// How far (as a factor either way) a point's metric may stray from the median in either
 /// principal direction: a first fit that wandered off (no data near) gives no trustworthy metric.
@@ -26,25 +26,59 @@ pub(crate) const METRIC_CLAMP: f64 = 1e4;
 const METRIC_SMOOTHING: usize = 2;
 
 /// One grid point's metric [E, F, G] (per grid step).
-type Metric = [f64; 3];
+pub(crate) type Metric = [f64; 3];
 
-/// The arc-length thin-plate rows of every chart's control grid, from the control points of a
-/// first fit (`control`): three rows per interior grid point (the Hessian's uu, √2·uv and vv
-/// entries in arc length).
-pub(crate) fn arc_length_rows(layout: &Layout, control: &[Point3]) -> Vec<Vec<(usize, f64)>> {
-    let metrics: Vec<Vec<Metric>> = layout
+/// Each chart's metric (per grid step of `layout`, at each of its grid points in order), read off
+/// the surface with control points `control` on `source`, a layout over the same atlas (perhaps
+/// with coarser grids): the first derivatives of the chart's own patch there, at the grid points'
+/// Greville abscissae (the parameters the control points sit over; clamped into the chart), then
+/// [`smoothed`].
+pub(crate) fn patch_metrics(
+    layout: &Layout,
+    source: &Layout,
+    control: &[Point3],
+) -> Vec<Vec<Metric>> {
+    layout
         .atlas()
         .charts()
         .iter()
         .map(|chart| {
-            let g = layout.grid(chart.id());
-            let at = |i: usize, j: usize| control[layout.control_index(chart.id(), i, j)];
-            smoothed(grid_metric(g, at), g)
+            let (fine, coarse) = (layout.basis(chart.id()), source.basis(chart.id()));
+            let p = fine.degree();
+            // Knots are h apart, so function i's Greville abscissa is its knot i + (p + 1)/2 steps.
+            let h = fine.knot(1) - fine.knot(0);
+            let greville = |i: usize| fine.knot(i as isize) + 0.5 * (p + 1) as f64 * h;
+            let g = fine.count();
+            let q = coarse.degree() + 1;
+            let mut metric = Vec::with_capacity(g * g);
+            for j in 0..g {
+                let (fv, nv) = coarse.eval(greville(j), 1);
+                for i in 0..g {
+                    let (fu, nu) = coarse.eval(greville(i), 1);
+                    let (mut su, mut sv) = (Vector3::zeros(), Vector3::zeros());
+                    for (b, (&v, &dv)) in nv[0][..q].iter().zip(&nv[1][..q]).enumerate() {
+                        for (a, (&u, &du)) in nu[0][..q].iter().zip(&nu[1][..q]).enumerate() {
+                            let c = control[source.control_index(chart.id(), fu + a, fv + b)];
+                            su += c.coords * (du * v);
+                            sv += c.coords * (u * dv);
+                        }
+                    }
+                    let (su, sv) = (su * h, sv * h);
+                    metric.push([su.dot(&su), su.dot(&sv), sv.dot(&sv)]);
+                }
+            }
+            smoothed(metric, g)
         })
-        .collect();
-    let scale = median_area(&metrics);
+        .collect()
+}
+
+/// The arc-length thin-plate rows of every chart's control grid, given each chart's `metrics`
+/// ([`patch_metrics`]): three rows per interior grid point (the Hessian's uu, √2·uv and vv entries
+/// in arc length).
+pub(crate) fn arc_length_rows(layout: &Layout, metrics: &[Vec<Metric>]) -> Vec<Vec<(usize, f64)>> {
+    let scale = median_area(metrics);
     let mut rows = Vec::new();
-    for (chart, metric) in layout.atlas().charts().iter().zip(&metrics) {
+    for (chart, metric) in layout.atlas().charts().iter().zip(metrics) {
         let g = layout.grid(chart.id());
         let index = |i: usize, j: usize| layout.control_index(chart.id(), i, j);
         for j in 1..g.saturating_sub(1) {
@@ -55,21 +89,6 @@ pub(crate) fn arc_length_rows(layout: &Layout, control: &[Point3]) -> Vec<Vec<(u
         }
     }
     rows
-}
-
-/// The metric of a g × g grid at each point, from central differences (one-sided at the sides).
-fn grid_metric(g: usize, at: impl Fn(usize, usize) -> Point3) -> Vec<Metric> {
-    let mut metric = Vec::with_capacity(g * g);
-    for j in 0..g {
-        for i in 0..g {
-            let (i0, i1) = (i.saturating_sub(1), (i + 1).min(g - 1));
-            let (j0, j1) = (j.saturating_sub(1), (j + 1).min(g - 1));
-            let su = (at(i1, j) - at(i0, j)) / (i1 - i0) as f64;
-            let sv = (at(i, j1) - at(i, j0)) / (j1 - j0) as f64;
-            metric.push([su.dot(&su), su.dot(&sv), sv.dot(&sv)]);
-        }
-    }
-    metric
 }
 
 /// The metric averaged [`METRIC_SMOOTHING`] times with each point's four neighbours: a first fit's
@@ -233,8 +252,9 @@ mod tests {
             let interior = (atlas.charts().len() * 10 * 10) as f64;
             // The metric is scaled to a median area element of 1: a grid step of 1/g in units where
             // the sheet's own bending is per unit length, so the grid's energy per point is g⁻⁴ of it.
+            let metrics = patch_metrics(&layout, &layout, &control);
             let read =
-                energy(&arc_length_rows(&layout, &control), &control) / interior * 12f64.powi(4);
+                energy(&arc_length_rows(&layout, &metrics), &control) / interior * 12f64.powi(4);
             assert!(
                 (read - exact).abs() < 0.02 * exact,
                 "stretch {stretch:.2}, shear {shear:.2}: {read:e} against {exact:e}"

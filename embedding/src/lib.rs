@@ -31,6 +31,7 @@ pub mod floater;
 pub mod harmonic;
 pub mod holed;
 pub mod integrals;
+mod least_squares;
 pub mod mesh_fit;
 pub mod model;
 pub mod quality;
