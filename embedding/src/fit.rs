@@ -236,6 +236,14 @@ pub struct FitSettings {
     /// surface more one way than the other (a user's tubes and limbs), and for `new`'s plates up to
     /// genus 10 ([`plate_surface_smoothness`]), whose eased rims it smooths.
     pub surface_smoothness: bool,
+    /// How many times coarser (per side) the grids of the first fit that gives the arc-length term
+    /// its metric are: 1, the same grids (the metric from the control points' differences); 2,
+    /// half as fine (from the patches' derivatives at the grid points), for a quarter of the
+    /// control points. `new`'s plates take 2 ([`FitSettings::for_plate`]; the same |κ|, normals
+    /// and flat faces at genus 3 and 10 to within 0.01, 1.4 s less at genus 10). A user's mesh
+    /// keeps 1: the gear's needle walls (`assets/meshes/gear-genus-1.obj`) read a coarse fit's
+    /// metric badly (normals 70° off its mesh's at the 90th percentile at λ = 0.002, against 28°).
+    pub metric_coarsening: usize,
     /// Where the fitted surface is rough by `ntori fit`'s shape checks, fit again with a larger
     /// smoothness (a user's mesh: [`crate::mesh_fit`]'s `smooth_enough`); off where the user
     /// chose λ.
@@ -251,6 +259,7 @@ impl Default for FitSettings {
             sweeps: 5000,
             even_rounds: crate::mesh_fit::EVEN_ROUNDS,
             surface_smoothness: false,
+            metric_coarsening: 1,
             raise_smoothness: false,
         }
     }
@@ -451,6 +460,9 @@ pub fn default_settings(genus: u32) -> (SplineSettings, FitSettings) {
     (spline, FitSettings::for_plate(genus, spline.grid))
 }
 
+/// [`FitSettings::metric_coarsening`] for `new`'s plates.
+pub const PLATE_METRIC_COARSENING: usize = 2;
+
 /// The highest genus whose plate is fitted with the smoothness term in arc length
 /// ([`plate_surface_smoothness`]).
 pub const PLATE_SURFACE_SMOOTHNESS_UP_TO: u32 = 10;
@@ -513,6 +525,7 @@ impl FitSettings {
     pub fn for_plate(genus: u32, grid: usize) -> FitSettings {
         FitSettings {
             surface_smoothness: plate_surface_smoothness(genus, grid),
+            metric_coarsening: PLATE_METRIC_COARSENING,
             ..FitSettings::for_grid(grid)
         }
     }
@@ -1473,14 +1486,11 @@ pub fn fit(
     control_points(&x, settings.smoothness)
 }
 
-/// How many times coarser (per side) the grids of [`arc_length_smoothness`]'s first fit are.
-const METRIC_FIT_COARSENING: usize = 2;
-
 /// The smoothness rows in the surface's arc length ([`FitSettings::surface_smoothness`]), with the
-/// metric read off a first fit with the plain rows on grids [`METRIC_FIT_COARSENING`] times
-/// coarser. The metric only weighs the rows (and is smoothed and clamped), so the coarse fit's is
-/// close enough, and it costs a fraction of a second fit on the full grids: at genus 10 the full
-/// first fit took 1.8 s of the fit's 3.7 s.
+/// metric read off a first fit with the plain rows: on the same grids, from its control points'
+/// differences, or on grids [`FitSettings::metric_coarsening`] times coarser, from its patches'
+/// derivatives (at genus 10 the full first fit took 1.8 s of the fit's 3.7 s; the coarse one
+/// about 0.6 s).
 fn arc_length_smoothness(
     layout: &Layout,
     points: &[ChartPoint],
@@ -1489,7 +1499,17 @@ fn arc_length_smoothness(
     settings: FitSettings,
 ) -> Result<Vec<Vec<(usize, f64)>>, EmbeddingError> {
     let fine = layout.settings();
-    let coarser = |g: usize| (g / METRIC_FIT_COARSENING).max(fine.degree + 2);
+    let coarsening = settings.metric_coarsening.max(1);
+    let plain = FitSettings {
+        surface_smoothness: false,
+        ..settings
+    };
+    if coarsening == 1 {
+        let control = fit(layout, points, targets, weights, plain)?;
+        let metrics = crate::bending::grid_metrics(layout, &control);
+        return Ok(crate::bending::arc_length_rows(layout, &metrics));
+    }
+    let coarser = |g: usize| (g / coarsening).max(fine.degree + 2);
     let coarse = SplineSettings {
         grid: coarser(fine.grid),
         disk_grid: fine.disk_grid.map(coarser),
@@ -1500,9 +1520,8 @@ fn arc_length_smoothness(
     // power (λ (N / R) Σ (Δ²P)² with Δ²P ≈ h² S''), so the coarse grid takes λ scaled down by it.
     let step = |g: usize| 1.0 / (g - fine.degree) as f64;
     let plain = FitSettings {
-        surface_smoothness: false,
         smoothness: settings.smoothness * (step(fine.grid) / step(coarse.grid)).powi(4),
-        ..settings
+        ..plain
     };
     let control = fit(&coarse_layout, points, targets, weights, plain)?;
     Ok(crate::bending::arc_length_rows(

@@ -236,6 +236,8 @@ pub fn mesh_model(
         OwnShape {
             curvature: quality::mesh_max_principal_curvature(positions, triangles, &normals),
             normals,
+            sharp: quality::SharpEdges::of(positions, triangles),
+            band: quality::CREASE_BAND * diagonal(positions),
         }
     });
     let input = MeshInput {
@@ -307,6 +309,9 @@ struct MeshInput<'a> {
 struct OwnShape {
     normals: Vec<Vector3>,
     curvature: f64,
+    /// Its sharp edges, and how far from them (model units) the curvature check looks away.
+    sharp: quality::SharpEdges,
+    band: f64,
 }
 
 /// The least-squares fit through the mesh's vertices at the map's points, and its residual.
@@ -375,8 +380,12 @@ pub const ROUGHNESS_SAMPLES: u32 = 16;
 /// against the others.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Roughness {
-    /// The surface's largest |κ| over the mesh's.
+    /// The surface's largest |κ| over the mesh's, away from the mesh's sharp edges
+    /// ([`quality::CREASE_BAND`]).
     pub curvature_ratio: f64,
+    /// The tightest rounding of a sharp edge, as a radius over the diagonal
+    /// ([`quality::MIN_CREASE_ROUNDING`]); `None` for a mesh without sharp edges.
+    pub crease_rounding: Option<f64>,
     /// The largest disagreement of two patches, as a fraction of the mesh's diagonal.
     pub disagreement: f64,
     /// The 90th percentile of the angle (degrees) between the surface's normals and the mesh's
@@ -398,13 +407,16 @@ struct Reference<'a> {
 impl Roughness {
     fn measure(surface: &Surface, reference: &Reference) -> Result<Roughness, EmbeddingError> {
         let samples = quality::sample_points(surface, ROUGHNESS_SAMPLES)?;
-        let largest = quality::max_principal_curvature(surface, &samples).max_abs;
+        let own = reference.own;
+        let curvature =
+            quality::max_principal_curvature_by_creases(surface, &samples, &own.sharp, own.band);
         let disagreement = quality::patch_disagreement(surface, &samples, 0.1).max;
         let normals =
             quality::normal_deviation_from(surface, reference.points, &reference.own.normals);
         let residual = largest_residual(surface, reference.points, reference.positions);
         Ok(Roughness {
-            curvature_ratio: largest / reference.own.curvature,
+            curvature_ratio: curvature.away.max_abs / own.curvature,
+            crease_rounding: curvature.rounding(reference.diagonal),
             disagreement: disagreement / reference.diagonal,
             normals_p90: normals.p90,
             residual: residual / reference.diagonal,
@@ -413,9 +425,11 @@ impl Roughness {
 
     /// Each measure as a multiple of its tolerance (at most 1 passes); a non-finite measure (a
     /// degenerate surface) is as bad as it gets.
-    fn excesses(&self) -> [f64; 4] {
+    fn excesses(&self) -> [f64; 5] {
         [
             self.curvature_ratio / quality::CURVATURE_RATIO_TOLERANCE_MESH,
+            self.crease_rounding
+                .map_or(0.0, |r| quality::MIN_CREASE_ROUNDING / r),
             self.disagreement / quality::DISAGREEMENT_TOLERANCE,
             self.normals_p90 / quality::NORMAL_TOLERANCE_MESH,
             self.residual / quality::RESIDUAL_TOLERANCE,

@@ -188,10 +188,32 @@ fn project(
 
 /// Vertices on an edge whose triangles' normals turn more than [`SHARP_DIHEDRAL_DEGREES`].
 fn sharp_vertices(n: usize, triangles: &[[u32; 3]], normals: &[Point]) -> Vec<bool> {
+    let mut pinned = vec![false; n];
+    for (a, b) in sharp_edges_with(triangles, normals) {
+        pinned[a as usize] = true;
+        pinned[b as usize] = true;
+    }
+    pinned
+}
+
+/// A mesh's sharp edges: those across which its triangles' normals turn more than
+/// [`SHARP_DIHEDRAL_DEGREES`] (a crease or a corner's edge, which a smooth surface rounds), each
+/// as its two vertices, the smaller first, in the order the triangles first reach them. Edges
+/// of a triangle without area (no normal) count as sharp.
+pub fn sharp_edges(positions: &[Point], triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
+    let normals: Vec<Point> = triangles
+        .iter()
+        .map(|t| unit_normal(t.map(|v| positions[v as usize])))
+        .collect();
+    sharp_edges_with(triangles, &normals)
+}
+
+/// [`sharp_edges`] given the triangles' unit normals.
+fn sharp_edges_with(triangles: &[[u32; 3]], normals: &[Point]) -> Vec<(u32, u32)> {
     let cos_sharp = SHARP_DIHEDRAL_DEGREES.to_radians().cos();
     let mut edges: std::collections::HashMap<(u32, u32), usize> =
         std::collections::HashMap::with_capacity(triangles.len() * 3 / 2);
-    let mut pinned = vec![false; n];
+    let mut sharp = Vec::new();
     for (i, t) in triangles.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -199,12 +221,11 @@ fn sharp_vertices(n: usize, triangles: &[[u32; 3]], normals: &[Point]) -> Vec<bo
             if let Some(j) = edges.insert(key, i)
                 && dot(&normals[i], &normals[j]) < cos_sharp
             {
-                pinned[a as usize] = true;
-                pinned[b as usize] = true;
+                sharp.push(key);
             }
         }
     }
-    pinned
+    sharp
 }
 
 /// Vertices of a triangle with an angle under [`THIN_ANGLE_DEGREES`], and their neighbours.

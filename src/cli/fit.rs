@@ -477,12 +477,17 @@ fn smoothness_text(report: &SmoothnessReport) -> String {
     let largest = report.tried.last().map_or(report.used, |t| t.smoothness);
     format!(
         "smoothness: λ raised from {asked} to {} (tried up to {largest}; measured at t = {}): at \
-         {asked} the surface's largest |κ| was {:.2}× the mesh's, its patches {:.3}% of the \
+         {asked} the surface's largest |κ| was {:.2}× the mesh's{}, its patches {:.3}% of the \
          diagonal apart, its normals {:.1}° off the mesh's (90%) and its residual {:.3}%; at {}, \
          {:.2}×, {:.3}%, {:.1}° and {:.3}%\n",
         report.used,
         embedding::mesh_fit::ROUGHNESS_SAMPLES,
         first.curvature_ratio,
+        if first.crease_rounding.is_some() {
+            " away from its sharp edges"
+        } else {
+            ""
+        },
         100.0 * first.disagreement,
         first.normals_p90,
         100.0 * first.residual,

@@ -237,6 +237,12 @@ pub struct ShapeReport {
     /// ([`embedding::quality::mesh_max_principal_curvature`]), and the surface's as a multiple of it.
     pub input_max_principal_curvature: f64,
     pub curvature_ratio: f64,
+    /// The input mesh's sharp edges (`embedding::quality::SharpEdges`; none for `new`'s plates):
+    /// the largest |κ| above leaves out the points within `CREASE_BAND` of the diagonal of them,
+    /// and `crease_rounding` is the tightest radius (over the diagonal) the surface rounds them
+    /// to, checked against `MIN_CREASE_ROUNDING`; `None` where no point is near one.
+    pub sharp_edges: usize,
+    pub crease_rounding: Option<f64>,
     /// The angle between the surface's normal and the reference normal at the input mesh's
     /// vertices, in degrees: median and 90th percentile.
     pub normal_deviation_median: f64,
@@ -272,30 +278,42 @@ const SHAPE_SAMPLES: u32 = 16;
 /// keeps its crossings at 64. (Genus 16: 1.7 s at 32, 3.9 s at 48, 6.9 s at 64.)
 pub const INTERSECTION_SAMPLES: [u32; 3] = [32, 48, 64];
 
-/// The shape measures; `dense_curvature` is the largest |κ| the Gauss–Bonnet check's quadrature
-/// found.
+/// The shape measures; `dense` is the largest |κ| the Gauss–Bonnet check's quadrature found.
 fn measure_shape(
     fitted: &Fitted,
     diagonal: f64,
-    dense_curvature: f64,
+    dense: embedding::quality::CurvatureExtreme,
     stage: &dyn Fn(&str),
 ) -> Result<ShapeReport, embedding::EmbeddingError> {
     use embedding::quality;
     let surface = fitted.surface;
     let points = quality::sample_points(surface, SHAPE_SAMPLES)?;
     let disagreement = quality::patch_disagreement(surface, &points, 0.1);
-    let largest = quality::max_principal_curvature(surface, &points)
-        .max_abs
-        .max(dense_curvature);
     let at = &fitted.parameterization.points;
     let mesh_normals;
-    let (reference, normals_from) = match fitted.intended_normals {
-        Some(intended) => (intended, NormalReference::Intended),
+    // A user's mesh may have sharp edges, which the surface rounds: its curvature is checked
+    // away from them, and how tightly it rounds them on its own. The plates have none.
+    let (reference, normals_from, sharp) = match fitted.intended_normals {
+        Some(intended) => (
+            intended,
+            NormalReference::Intended,
+            quality::SharpEdges::default(),
+        ),
         None => {
             mesh_normals = quality::vertex_normals(fitted.positions, fitted.triangles);
-            (&mesh_normals[..], NormalReference::Mesh)
+            let sharp = quality::SharpEdges::of(fitted.positions, fitted.triangles);
+            (&mesh_normals[..], NormalReference::Mesh, sharp)
         }
     };
+    let band = quality::CREASE_BAND * diagonal;
+    let curvature = quality::max_principal_curvature_by_creases(surface, &points, &sharp, band)
+        .max(quality::max_principal_curvature_by_creases(
+            surface,
+            &Vec::from_iter(dense.at),
+            &sharp,
+            band,
+        ));
+    let largest = curvature.away.max_abs;
     let normals = quality::normal_deviation_from(surface, at, reference);
     stage("measuring the distance to the input");
     let (distance, distance_samples) = quality::hausdorff_to_mesh_resolved(
@@ -316,6 +334,8 @@ fn measure_shape(
         max_principal_curvature: largest,
         input_max_principal_curvature: input_curvature,
         curvature_ratio: largest / input_curvature,
+        sharp_edges: sharp.len(),
+        crease_rounding: curvature.rounding(diagonal),
         normal_deviation_median: normals.median,
         normal_deviation_p90: normals.p90,
         normals_from,
@@ -339,7 +359,10 @@ impl ShapeReport {
         };
         ShapeVerdict {
             disagreement: self.patch_disagreement <= DISAGREEMENT_TOLERANCE,
-            curvature: self.curvature_ratio <= curvature_tolerance,
+            curvature: self.curvature_ratio <= curvature_tolerance
+                && self
+                    .crease_rounding
+                    .is_none_or(|r| r >= embedding::quality::MIN_CREASE_ROUNDING),
             normals: self.normal_deviation_p90 <= normal_tolerance,
             embedded: self.self_intersections == 0,
         }
@@ -433,7 +456,11 @@ pub fn check(
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
     let curvature_error = sums.gauss_bonnet_error(genus);
     stage("measuring the shape");
-    let shape = measure_shape(fitted, mesh_diagonal, sums.largest_curvature, stage)?;
+    let dense = embedding::quality::CurvatureExtreme {
+        max_abs: sums.largest_curvature,
+        at: sums.largest_curvature_at,
+    };
+    let shape = measure_shape(fitted, mesh_diagonal, dense, stage)?;
     let shape_verdict = shape.verdict();
     Ok(NewReport {
         genus,
@@ -513,6 +540,27 @@ pub fn make(
 }
 
 impl NewReport {
+    /// Where the input has sharp edges, how the curvature check treats them, in words (else
+    /// nothing).
+    fn crease_text(&self) -> String {
+        let shape = &self.shape;
+        if shape.sharp_edges == 0 {
+            return String::new();
+        }
+        let rounding = shape.crease_rounding.map_or(String::new(), |r| {
+            format!(
+                "; rounds them to a radius of {:.2}% of the diagonal (at least {}%)",
+                100.0 * r,
+                100.0 * embedding::quality::MIN_CREASE_ROUNDING
+            )
+        });
+        format!(
+            " away from its {} (within {}% of the diagonal){rounding}",
+            count(shape.sharp_edges, "sharp mesh edge", "sharp mesh edges"),
+            100.0 * embedding::quality::CREASE_BAND
+        )
+    }
+
     /// How the map was solved, in words.
     fn solve_text(&self) -> String {
         match self.newton {
@@ -555,7 +603,7 @@ impl NewReport {
              (Hausdorff, t_e = t_r = {dist_t})\n\
              Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, relative error {gb:.1e} ({gbv})\n\
              patches: disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%) ({pdv})\n\
-             curvature: largest |κ| {kmax:.2}, {ratio:.2}× the input's {kin:.2} ({kv})\n\
+             curvature: largest |κ| {kmax:.2}, {ratio:.2}× the input's {kin:.2}{creases} ({kv})\n\
              normals: {nmed:.2}° from the {reference} (90%: {n90:.2}°) ({nv})\n\
              self-intersections: {crossings} crossing triangle pairs at t_e = t_r = {t} ({ev}){coarse}\n\
              area {area:.4}, {secs:.2} s\n",
@@ -587,6 +635,7 @@ impl NewReport {
             ratio = self.shape.curvature_ratio,
             kin = self.shape.input_max_principal_curvature,
             kv = verdict(self.shape_verdict.curvature),
+            creases = self.crease_text(),
             nmed = self.shape.normal_deviation_median,
             reference = match self.shape.normals_from {
                 NormalReference::Intended => "intended shape's",
