@@ -521,12 +521,19 @@ impl FitSettings {
     }
 
     /// [`FitSettings::for_grid`] for `ntori new`'s plate of `genus`: the smoothness term in arc
-    /// length where [`plate_surface_smoothness`] says.
+    /// length where [`plate_surface_smoothness`] says ([`FitSettings::plate_smoothness`]).
     pub fn for_plate(genus: u32, grid: usize) -> FitSettings {
+        FitSettings::for_grid(grid).plate_smoothness(genus, grid)
+    }
+
+    /// These settings with the smoothness term a plate of `genus` on a grid of `grid` is fitted
+    /// with: in arc length where [`plate_surface_smoothness`] says, its metric from a fit on
+    /// grids [`PLATE_METRIC_COARSENING`] times coarser.
+    pub fn plate_smoothness(self, genus: u32, grid: usize) -> FitSettings {
         FitSettings {
             surface_smoothness: plate_surface_smoothness(genus, grid),
             metric_coarsening: PLATE_METRIC_COARSENING,
-            ..FitSettings::for_grid(grid)
+            ..self
         }
     }
 }

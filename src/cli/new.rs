@@ -85,11 +85,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         quiet,
     } = args;
-    let (settings, mut fit) =
-        spline.settings(genus, embedding::fit::default_grid(genus), |grid| {
-            embedding::fit::default_disk_grid(genus, grid)
-        })?;
-    fit.surface_smoothness = embedding::fit::plate_surface_smoothness(genus, settings.grid);
+    let (settings, fit) = spline.settings(genus, embedding::fit::default_grid(genus), |grid| {
+        embedding::fit::default_disk_grid(genus, grid)
+    })?;
+    let fit = fit.plate_smoothness(genus, settings.grid);
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;
