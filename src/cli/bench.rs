@@ -62,7 +62,9 @@ pub struct Figure {
     /// Items per second (points, vertices, triangles, events).
     pub per_second: f64,
     pub unit: &'static str,
-    /// per_second × bytes per item ÷ copy bandwidth, where the figure is memory-bound.
+    /// per_second × bytes per item ÷ copy bandwidth, where the figure is memory-bound: the
+    /// all-cores copy bandwidth for the figures named `…_all_cores`, the one-thread copy's for the
+    /// others.
     pub fraction_of_copy_bandwidth: Option<f64>,
     /// per_second ÷ the scalar baseline (multiply-adds per second in a dependent chain).
     pub per_baseline_op: f64,
@@ -82,6 +84,11 @@ pub struct BenchReport {
     pub vertices: usize,
     /// Baselines, measured in this run.
     pub copy_bandwidth_bytes_per_second: f64,
+    /// The same copy split over every core (`threads` of them): what the `…_all_cores` figures'
+    /// scaling is bounded by where they are memory-bound (this machine's 2 cores copied 1.5 to 2.3
+    /// times as fast as one, in three runs).
+    pub copy_bandwidth_all_cores_bytes_per_second: f64,
+    pub threads: usize,
     pub scalar_ops_per_second: f64,
     /// The adapter the GPU figures ran on (with `--gpu`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -104,12 +111,22 @@ fn best_of(runs: usize, mut f: impl FnMut()) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-fn copy_bandwidth() -> f64 {
+/// Bytes read and written per second copying 128 MiB: on one thread, or (`all_cores`) in chunks
+/// over rayon's threads.
+fn copy_bandwidth(all_cores: bool) -> f64 {
+    use rayon::prelude::*;
     let words = 16 << 20;
     let src: Vec<u64> = (0..words as u64).collect();
     let mut dst = vec![0u64; words];
     let t = best_of(3, || {
-        dst.copy_from_slice(black_box(&src));
+        if all_cores {
+            const CHUNK: usize = 1 << 16;
+            dst.par_chunks_mut(CHUNK)
+                .zip(black_box(&src).par_chunks(CHUNK))
+                .for_each(|(d, s)| d.copy_from_slice(s));
+        } else {
+            dst.copy_from_slice(black_box(&src));
+        }
         black_box(&mut dst);
     });
     (2 * 8 * words) as f64 / t
@@ -136,7 +153,8 @@ pub fn measure(
     progress: &dyn Fn(&str),
 ) -> anyhow::Result<BenchReport> {
     progress("baselines");
-    let (bandwidth, scalar) = (copy_bandwidth(), scalar_ops());
+    let (bandwidth, scalar) = (copy_bandwidth(false), scalar_ops());
+    let bandwidth_all_cores = copy_bandwidth(true);
     let atlas = Atlas::new(genus)?;
     let t = tessellation_size(genus, vertices);
     let mut figures = Vec::new();
@@ -145,7 +163,14 @@ pub fn measure(
             name: name.into(),
             per_second,
             unit,
-            fraction_of_copy_bandwidth: bytes.map(|b| per_second * b / bandwidth),
+            fraction_of_copy_bandwidth: bytes.map(|b| {
+                let baseline = if name.ends_with("_all_cores") {
+                    bandwidth_all_cores
+                } else {
+                    bandwidth
+                };
+                per_second * b / baseline
+            }),
             per_baseline_op: per_second / scalar,
         })
     };
@@ -311,6 +336,8 @@ pub fn measure(
         genus,
         vertices: pts.len(),
         copy_bandwidth_bytes_per_second: bandwidth,
+        copy_bandwidth_all_cores_bytes_per_second: bandwidth_all_cores,
+        threads: rayon::current_num_threads(),
         scalar_ops_per_second: scalar,
         gpu_adapter,
         gpu_agreement,

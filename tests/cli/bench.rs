@@ -6,6 +6,13 @@ use crate::common::{ntori, ntori_json};
 fn bench_prints_json_figures() {
     let v = ntori_json(&["bench", "--quiet", "--vertices", "3000", "--genus", "3"]);
     assert!(v["copy_bandwidth_bytes_per_second"].as_f64().unwrap() > 1e8);
+    assert!(
+        v["copy_bandwidth_all_cores_bytes_per_second"]
+            .as_f64()
+            .unwrap()
+            > 1e8
+    );
+    assert!(v["threads"].as_u64().unwrap() >= 1);
     let figures = v["figures"].as_array().unwrap();
     let names: Vec<&str> = figures
         .iter()
