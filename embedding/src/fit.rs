@@ -232,9 +232,10 @@ pub struct FitSettings {
     /// triangles). The plates are even already and ignore it.
     pub even_rounds: usize,
     /// Measure the smoothness term in the surface's own arc length (`bending.rs`), with the metric
-    /// of a first fit on grids half as fine (`arc_length_smoothness`). For maps that stretch the
-    /// surface more one way than the other (a user's tubes and limbs), and for `new`'s plates up to
-    /// genus 15 ([`plate_surface_smoothness`]), whose eased rims it smooths.
+    /// of a first fit (`arc_length_smoothness`, on grids [`FitSettings::metric_coarsening`] times
+    /// coarser). For maps that stretch the surface more one way than the other (a user's tubes
+    /// and limbs), and for `new`'s plates up to genus 15 ([`plate_surface_smoothness`]), whose
+    /// eased rims it smooths.
     pub surface_smoothness: bool,
     /// How many times coarser (per side) the grids of the first fit that gives the arc-length term
     /// its metric are: 1, the same grids (the metric from the control points' differences); 2,
@@ -553,10 +554,11 @@ impl FitSettings {
 }
 
 /// The resolution `ntori new` and the editor use for `genus`: [`TORUS_RESOLUTION`] for the torus,
-/// [`FINE_RESOLUTION`] for genus 3 to 9 and 11 to 15, [`DEFAULT_RESOLUTION`] for the others, or where that mesh has more than
-/// [`DEFAULT_FIT_TRIANGLES`] (genus 24 and 32, not 16), nearly the finest within it (the plates'
-/// triangles grow as the resolution's square): genus 24 gets 28, 32 gets 21. Where even resolution
-/// 8 has more, 8 (genus 64: 223 516 triangles, within [`MAX_FIT_TRIANGLES`]).
+/// [`FINE_RESOLUTION`] for genus 3 to 9 and 11 to 15, [`DEFAULT_RESOLUTION`] for the others, or
+/// where that mesh has more than [`DEFAULT_FIT_TRIANGLES`] (genus 24 and 32, not 16), nearly the
+/// finest within it (the plates' triangles grow as the resolution's square): genus 24 gets 28, 32
+/// gets 21. Where even resolution 8 has more, 8 (genus 64: 223 516 triangles, within
+/// [`MAX_FIT_TRIANGLES`]).
 ///
 /// Why 40 from genus 3 to 9: there the fit's largest curvature sits on a hole's rim between the
 /// input's vertices (0.1 apart on a rim of radius 0.25 at 32), and its size follows the rim's
