@@ -1514,24 +1514,23 @@ pub fn fit(
             settings.smoothness
         )));
     }
+    let data = DataRows::new(layout, points, targets, weights, settings.patch_weight);
     let smooth = if settings.surface_smoothness {
-        arc_length_smoothness(layout, points, targets, weights, settings)?
+        arc_length_smoothness(layout, &data, points, targets, weights, settings)?
     } else {
         smoothness_rows(layout)
     };
-    let data = DataRows::new(layout, points, targets, weights, settings.patch_weight);
-    let (rows, triplets, rhs) = data.with_smoothness(&smooth, settings.smoothness);
-    let x = LeastSquares::new(rows, layout.control_count(), &triplets)?.solve(&rhs);
-    control_points(&x, settings.smoothness)
+    data.solve(layout, &smooth, settings.smoothness)
 }
 
 /// The smoothness rows in the surface's arc length ([`FitSettings::surface_smoothness`]), with the
-/// metric read off a first fit with the plain rows: on the same grids, from its control points'
-/// differences, or on grids [`FitSettings::metric_coarsening`] times coarser, from its patches'
-/// derivatives (at genus 10 the full first fit took 1.8 s of the fit's 3.7 s; the coarse one
-/// about 0.6 s).
+/// metric read off a first fit with the plain rows: on the same grids (through `data`, the fit's
+/// own rows), from its control points' differences, or on grids
+/// [`FitSettings::metric_coarsening`] times coarser, from its patches' derivatives (at genus 10
+/// the full first fit took 1.8 s of the fit's 3.7 s; the coarse one about 0.6 s).
 fn arc_length_smoothness(
     layout: &Layout,
+    data: &DataRows,
     points: &[ChartPoint],
     targets: &[Point3],
     weights: &[f64],
@@ -1539,12 +1538,8 @@ fn arc_length_smoothness(
 ) -> Result<Vec<Vec<(usize, f64)>>, EmbeddingError> {
     let fine = layout.settings();
     let coarsening = settings.metric_coarsening.max(1);
-    let plain = FitSettings {
-        surface_smoothness: false,
-        ..settings
-    };
     if coarsening == 1 {
-        let control = fit(layout, points, targets, weights, plain)?;
+        let control = data.solve(layout, &smoothness_rows(layout), settings.smoothness)?;
         let metrics = crate::bending::grid_metrics(layout, &control);
         return Ok(crate::bending::arc_length_rows(layout, &metrics));
     }
@@ -1559,8 +1554,9 @@ fn arc_length_smoothness(
     // power (λ (N / R) Σ (Δ²P)² with Δ²P ≈ h² S''), so the coarse grid takes λ scaled down by it.
     let step = |g: usize| 1.0 / (g - fine.degree) as f64;
     let plain = FitSettings {
+        surface_smoothness: false,
         smoothness: settings.smoothness * (step(fine.grid) / step(coarse.grid)).powi(4),
-        ..plain
+        ..settings
     };
     let control = fit(&coarse_layout, points, targets, weights, plain)?;
     Ok(crate::bending::arc_length_rows(
@@ -1642,6 +1638,19 @@ impl DataRows {
             rhs,
             points: points.len(),
         }
+    }
+
+    /// The control points fitting these rows with the smoothness rows `smooth` at weight λ
+    /// (`smoothness`; [`DataRows::with_smoothness`]).
+    fn solve(
+        &self,
+        layout: &Layout,
+        smooth: &[Vec<(usize, f64)>],
+        smoothness: f64,
+    ) -> Result<Vec<Point3>, EmbeddingError> {
+        let (rows, triplets, rhs) = self.with_smoothness(smooth, smoothness);
+        let x = LeastSquares::new(rows, layout.control_count(), &triplets)?.solve(&rhs);
+        control_points(&x, smoothness)
     }
 
     /// The whole system with the smoothness rows `smooth` at weight λ (`smoothness`) appended:

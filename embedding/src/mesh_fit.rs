@@ -237,7 +237,6 @@ pub fn mesh_model(
             curvature: quality::mesh_max_principal_curvature(positions, triangles, &normals),
             normals,
             sharp: quality::SharpEdges::of(positions, triangles),
-            band: quality::CREASE_BAND * diagonal(positions),
         }
     });
     let input = MeshInput {
@@ -309,9 +308,8 @@ struct MeshInput<'a> {
 struct OwnShape {
     normals: Vec<Vector3>,
     curvature: f64,
-    /// Its sharp edges, and how far from them (model units) the curvature check looks away.
+    /// Its sharp edges, which the curvature check looks away from.
     sharp: quality::SharpEdges,
-    band: f64,
 }
 
 /// The least-squares fit through the mesh's vertices at the map's points, and its residual.
@@ -408,8 +406,9 @@ impl Roughness {
     fn measure(surface: &Surface, reference: &Reference) -> Result<Roughness, EmbeddingError> {
         let samples = quality::sample_points(surface, ROUGHNESS_SAMPLES)?;
         let own = reference.own;
+        let band = quality::CREASE_BAND * reference.diagonal;
         let curvature =
-            quality::max_principal_curvature_by_creases(surface, &samples, &own.sharp, own.band);
+            quality::max_principal_curvature_by_creases(surface, &samples, &own.sharp, band);
         let disagreement = quality::patch_disagreement(surface, &samples, 0.1).max;
         let normals =
             quality::normal_deviation_from(surface, reference.points, &reference.own.normals);

@@ -220,18 +220,22 @@ impl CreaseCurvature {
         self.near.at.map(|_| 1.0 / (self.near.max_abs * diagonal))
     }
 
-    /// This and `other` (the same points' split, elsewhere) together: the larger of each side.
-    pub fn max(self, other: CreaseCurvature) -> CreaseCurvature {
-        let larger = |a: CurvatureExtreme, b: CurvatureExtreme| {
-            if b.at.is_some() && (a.at.is_none() || b.max_abs > a.max_abs) {
-                b
-            } else {
-                a
-            }
+    /// Takes in a largest |κ| found elsewhere (`extreme`, at surface position `position`) on the
+    /// side of `sharp` it lies on: within `band` of a sharp edge or not.
+    pub fn include(
+        &mut self,
+        extreme: CurvatureExtreme,
+        position: Point3,
+        sharp: &SharpEdges,
+        band: f64,
+    ) {
+        let side = if sharp.is_empty() || sharp.distance(position) > band {
+            &mut self.away
+        } else {
+            &mut self.near
         };
-        CreaseCurvature {
-            away: larger(self.away, other.away),
-            near: larger(self.near, other.near),
+        if extreme.at.is_some() && (side.at.is_none() || extreme.max_abs > side.max_abs) {
+            *side = extreme;
         }
     }
 }
@@ -249,16 +253,11 @@ pub fn max_principal_curvature_by_creases(
         blends: false,
     };
     evaluate::evaluate(surface, points, wants, 0.0, &mut |s: &evaluate::Sample| {
-        let k = sample_curvature(s);
-        let side = if sharp.is_empty() || sharp.distance(s.position) > band {
-            &mut out.away
-        } else {
-            &mut out.near
+        let here = CurvatureExtreme {
+            max_abs: sample_curvature(s),
+            at: Some(s.point),
         };
-        if k > side.max_abs || side.at.is_none() {
-            side.max_abs = k;
-            side.at = Some(s.point);
-        }
+        out.include(here, s.position, sharp, band);
     });
     out
 }

@@ -305,13 +305,10 @@ fn measure_shape(
         }
     };
     let band = quality::CREASE_BAND * diagonal;
-    let curvature = quality::max_principal_curvature_by_creases(surface, &points, &sharp, band)
-        .max(quality::max_principal_curvature_by_creases(
-            surface,
-            &Vec::from_iter(dense.at),
-            &sharp,
-            band,
-        ));
+    let mut curvature = quality::max_principal_curvature_by_creases(surface, &points, &sharp, band);
+    if let Some(at) = dense.at {
+        curvature.include(dense, surface.position(at), &sharp, band);
+    }
     let largest = curvature.away.max_abs;
     let normals = quality::normal_deviation_from(surface, at, reference);
     stage("measuring the distance to the input");
