@@ -34,8 +34,8 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use embedding::fit::{FitSettings, initial_model};
-use embedding::{SplineSettings, Surface, Vector3};
+use embedding::fit::{default_resolution, default_settings, initial_model};
+use embedding::{Surface, Vector3};
 use ntori::editor::EditorState;
 use ntori::editor::state::Grab;
 use ntori::render::Style;
@@ -43,8 +43,11 @@ use ntori::render::Style;
 /// t_e = t_r = t for about 10^5 and 10^6 vertices at genus 2 (V ≈ 20 t²).
 const SIZES: [(usize, u32); 2] = [(100_000, 71), (1_000_000, 224)];
 
+/// `ntori new`'s genus-2 model, as the editor opens it.
 fn model() -> Surface {
-    initial_model(2, 32, SplineSettings::default(), FitSettings::default())
+    let (spline, settings) = default_settings(2);
+    let resolution = default_resolution(2).expect("genus 2's resolution");
+    initial_model(2, resolution, spline, settings)
         .expect("the default model fits")
         .surface
 }

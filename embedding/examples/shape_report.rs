@@ -99,88 +99,58 @@ fn main() {
     }
 }
 
-/// On the plate's flat faces (input vertices at height ±T, away from the rims' bands) the intended
-/// normal is ±z and the mean curvature 0: the 90th percentile of the surface normal's angle from ±z,
-/// and of |H|·T (median, 90%), over those vertices weighted by their areas; with NTORI_CENTROIDS set, over the centres
-/// of the flat faces' triangles instead, between the points the fit sees. `None` for the sphere and
-/// the torus.
+/// On the plate's flat faces (`HoledMesh::flat_vertices`) the intended normal is ±z and the mean
+/// curvature 0: the 90th percentile of the surface normal's angle from ±z, and of |H|·T (median,
+/// 90%; T the half-thickness), weighted by the input's vertex areas
+/// (`embedding::quality::flat_faces`, as `ntori new` reports them); with NTORI_CENTROIDS set, at
+/// the centres of the flat faces' triangles instead, between the points the fit sees. `None` for
+/// the sphere and the torus.
 fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)> {
-    const THICKNESS: f64 = 0.35;
-    if fit.surface.genus() < 2 {
-        return None;
+    let mesh = &fit.mesh;
+    let flat = mesh.flat_vertices();
+    let areas = embedding::fit::vertex_areas(&mesh.positions, &mesh.triangles);
+    let mut is_flat = vec![false; mesh.positions.len()];
+    for &i in &flat {
+        is_flat[i] = true;
     }
-    let is_flat = |i: usize| (fit.mesh.positions[i].z.abs() - THICKNESS).abs() < 1e-12;
-    let areas = embedding::fit::vertex_areas(&fit.mesh.positions, &fit.mesh.triangles);
-    let (points, weights): (Vec<_>, Vec<f64>) = if std::env::var("NTORI_CENTROIDS").is_ok() {
-        let disk = fit.parameterization.disk.as_ref()?;
-        disk.triangles
-            .iter()
-            .filter(|t| {
-                t.iter()
-                    .all(|&c| is_flat(disk.original[c as usize] as usize))
-            })
-            .map(|t| {
-                let z = t
-                    .iter()
-                    .map(|&c| fit.parameterization.copies[c as usize])
-                    .sum::<num_complex::Complex64>()
-                    / 3.0;
-                let area: f64 = t
-                    .iter()
-                    .map(|&c| areas[disk.original[c as usize] as usize])
-                    .sum();
-                let point = fit
-                    .surface
-                    .atlas()
-                    .locate_model(charts::ModelPoint(z))
-                    .representations()[0];
-                (point, area)
-            })
-            .unzip()
-    } else {
-        (0..fit.mesh.positions.len())
-            .filter(|&i| is_flat(i))
-            .map(|i| (fit.parameterization.points[i], areas[i]))
-            .unzip()
-    };
-    let mut angles = vec![180.0; points.len()];
-    let mut curvatures = vec![f64::INFINITY; points.len()];
-    embedding::evaluate::evaluate(
-        &fit.surface,
-        &points,
-        embedding::evaluate::Wants {
-            curvature: true,
-            ..Default::default()
-        },
-        0.0,
-        &mut |s: &embedding::evaluate::Sample| {
-            if let Some(n) = s.normal {
-                angles[s.index] = n.z.abs().min(1.0).acos().to_degrees();
-            }
-            if let Some(c) = s.curvature {
-                curvatures[s.index] = c.mean.abs() * THICKNESS;
-            }
-        },
-    );
-    // Weighted by the input's vertex areas, so that a mesh denser near the rims does not count
-    // the flat faces' rim-side edges more than their middles.
-    let quantile = |v: &mut Vec<f64>, q: f64| {
-        let mut order: Vec<usize> = (0..v.len()).collect();
-        order.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
-        let total: f64 = weights.iter().sum();
-        let mut seen = 0.0;
-        for &i in &order {
-            seen += weights[i];
-            if seen >= q * total {
-                return v[i];
-            }
-        }
-        v[*order.last().expect("flat-face points")]
-    };
+    let up = |z: f64| embedding::Vector3::new(0.0, 0.0, z.signum());
+    let (points, (normals, weights)): (Vec<_>, (Vec<_>, Vec<f64>)) =
+        if std::env::var("NTORI_CENTROIDS").is_ok() {
+            let disk = fit.parameterization.disk.as_ref()?;
+            let original = |c: u32| disk.original[c as usize] as usize;
+            disk.triangles
+                .iter()
+                .filter(|t| t.iter().all(|&c| is_flat[original(c)]))
+                .map(|t| {
+                    let z = t
+                        .iter()
+                        .map(|&c| fit.parameterization.copies[c as usize])
+                        .sum::<num_complex::Complex64>()
+                        / 3.0;
+                    let area: f64 = t.iter().map(|&c| areas[original(c)]).sum();
+                    let point = fit
+                        .surface
+                        .atlas()
+                        .locate_model(charts::ModelPoint(z))
+                        .representations()[0];
+                    (point, (up(mesh.positions[original(t[0])].z), area))
+                })
+                .unzip()
+        } else {
+            flat.iter()
+                .map(|&i| {
+                    (
+                        fit.parameterization.points[i],
+                        (up(mesh.positions[i].z), areas[i]),
+                    )
+                })
+                .unzip()
+        };
+    let f = embedding::quality::flat_faces(&fit.surface, &points, &normals, &weights)?;
     Some((
-        quantile(&mut angles, 0.9),
-        quantile(&mut curvatures, 0.5),
-        quantile(&mut curvatures, 0.9),
-        points.len(),
+        f.normal_p90,
+        f.mean_curvature_median * mesh.thickness,
+        f.mean_curvature_p90 * mesh.thickness,
+        f.points,
     ))
 }

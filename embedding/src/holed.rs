@@ -457,6 +457,18 @@ impl Plan {
 }
 
 impl HoledMesh {
+    /// The vertices on a plate's flat faces (|z| = `thickness`, which the meshing sets exactly
+    /// there and nowhere else), where the intended surface is a plane: its normal ±z and its mean
+    /// curvature 0. None for the sphere and the torus.
+    pub fn flat_vertices(&self) -> Vec<usize> {
+        if self.genus < 2 {
+            return Vec::new();
+        }
+        (0..self.positions.len())
+            .filter(|&i| self.positions[i].z.abs() == self.thickness)
+            .collect()
+    }
+
     /// The genus-n mesh at `resolution` (boundary points around a hole, or around half the sphere's equator;
     /// 8 to 1024). Triangles have angles ≥ 20° in the plan; the rounded rims stretch them by up to π/2
     /// across the band.
@@ -765,6 +777,38 @@ mod tests {
     use proptest::prelude::*;
 
     const PROFILES: [Profile; 2] = [Profile::Round, Profile::Eased];
+
+    /// The flat faces are where the intended normal is ±z, top and bottom alike, and they hold
+    /// most of a plate's area (less as the holes crowd it); the sphere and the torus have none.
+    #[test]
+    fn the_flat_vertices_are_the_plates_faces() {
+        for genus in [0, 1] {
+            assert!(
+                HoledMesh::new(genus, 16)
+                    .unwrap()
+                    .flat_vertices()
+                    .is_empty()
+            );
+        }
+        for (genus, resolution) in [(2, 16), (3, 12), (5, 12), (10, 8)] {
+            let mesh = HoledMesh::new(genus, resolution).unwrap();
+            let flat = mesh.flat_vertices();
+            let areas = crate::fit::vertex_areas(&mesh.positions, &mesh.triangles);
+            let mut sides = [0.0, 0.0];
+            for &i in &flat {
+                let n = mesh.normals[i];
+                assert!(
+                    (n.z.abs() - 1.0).abs() < 1e-12 && n.z * mesh.positions[i].z > 0.0,
+                    "genus {genus}: vertex {i} normal {n:?}"
+                );
+                sides[usize::from(n.z > 0.0)] += areas[i];
+            }
+            let total: f64 = areas.iter().sum();
+            let share = (sides[0] + sides[1]) / total;
+            assert!((sides[0] - sides[1]).abs() < 1e-9 * total, "{sides:?}");
+            assert!((0.3..0.95).contains(&share), "genus {genus}: {share}");
+        }
+    }
 
     /// The bound that refuses a resolution before meshing is below the true count, and not so
     /// far below that it is useless (within a factor of 5).

@@ -38,6 +38,7 @@ impl LeastSquares {
         cols: usize,
         triplets: &[Triplet<usize, usize, f64>],
     ) -> Result<LeastSquares, EmbeddingError> {
+        let start = std::time::Instant::now();
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, triplets)
             .map_err(|e| failed(rows, cols, e))?;
         let at = a
@@ -52,6 +53,7 @@ impl LeastSquares {
             faer::Par::Seq,
         )
         .map_err(|e| failed(rows, cols, e))?;
+        let formed = start.elapsed().as_secs_f64();
         let (factor, ridge) = match gram.sp_cholesky(faer::Side::Lower) {
             Ok(factor) => (factor, 0.0),
             Err(_) => {
@@ -66,6 +68,14 @@ impl LeastSquares {
                 (factor, ridge)
             }
         };
+        tracing::debug!(
+            rows,
+            cols,
+            nonzeros = triplets.len(),
+            formed_seconds = formed,
+            factored_seconds = start.elapsed().as_secs_f64() - formed,
+            "least squares factored"
+        );
         Ok(LeastSquares {
             a,
             at,

@@ -284,6 +284,78 @@ impl AngleSpread {
     }
 }
 
+/// The fitted surface where the intended one is a plane (a plate's flat faces): how far it bends
+/// and turns there, as a designer sees a ripple. Quantiles are weighted (by area), so a mesh
+/// denser near the rims does not count the faces' rim-side edges more than their middles.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FlatFaces {
+    /// The points measured.
+    pub points: usize,
+    /// |H| (model units⁻¹): the median and the 90th percentile.
+    pub mean_curvature_median: f64,
+    pub mean_curvature_p90: f64,
+    /// The angle between the surface's normal and the plane's (degrees), 90th percentile.
+    pub normal_p90: f64,
+}
+
+/// [`FlatFaces`] at `points`, where the intended surface is flat with normal `normals[i]` (any
+/// length), weighted by `weights` (e.g. the input's vertex areas). A point where the surface has
+/// no normal or curvature counts as 180° and infinitely curved. `None` for no points.
+pub fn flat_faces(
+    surface: &Surface,
+    points: &[ChartPoint],
+    normals: &[Vector3],
+    weights: &[f64],
+) -> Option<FlatFaces> {
+    let n = points.len().min(normals.len()).min(weights.len());
+    if n == 0 {
+        return None;
+    }
+    let mut angles = vec![180.0; n];
+    let mut curvatures = vec![f64::INFINITY; n];
+    evaluate::evaluate(
+        surface,
+        &points[..n],
+        evaluate::Wants {
+            curvature: true,
+            ..Default::default()
+        },
+        0.0,
+        &mut |s: &evaluate::Sample| {
+            if let Some(normal) = s.normal
+                && normals[s.index].norm() > 0.0
+            {
+                angles[s.index] = normal.angle(&normals[s.index]).to_degrees();
+            }
+            if let Some(c) = s.curvature {
+                curvatures[s.index] = c.mean.abs();
+            }
+        },
+    );
+    let weights = &weights[..n];
+    Some(FlatFaces {
+        points: n,
+        mean_curvature_median: weighted_quantile(&curvatures, weights, 0.5),
+        mean_curvature_p90: weighted_quantile(&curvatures, weights, 0.9),
+        normal_p90: weighted_quantile(&angles, weights, 0.9),
+    })
+}
+
+/// The smallest of `values` below which at least `q` of the total weight lies.
+fn weighted_quantile(values: &[f64], weights: &[f64], q: f64) -> f64 {
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+    let total: f64 = weights.iter().sum();
+    let mut seen = 0.0;
+    for &i in &order {
+        seen += weights[i];
+        if seen >= q * total {
+            return values[i];
+        }
+    }
+    order.last().map_or(0.0, |&i| values[i])
+}
+
 /// The angle between the surface's normal at `points[i]` and the vertex normal of the mesh
 /// (`positions`, `triangles`, counter-clockwise seen from outside) at vertex i, over every vertex.
 /// A vertex whose mesh normal or surface normal is undefined counts as 180°.
@@ -546,6 +618,22 @@ pub fn normal_deviation_from(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The weighted quantile is the nearest rank's where the weights are equal, follows a heavy
+    /// weight, and ignores the order the values come in.
+    #[test]
+    fn weighted_quantiles_follow_the_weights() {
+        let values = [5.0, 1.0, 4.0, 2.0, 3.0];
+        let equal = [1.0; 5];
+        assert_eq!(weighted_quantile(&values, &equal, 0.5), 3.0);
+        assert_eq!(weighted_quantile(&values, &equal, 0.9), 5.0);
+        assert_eq!(weighted_quantile(&values, &equal, 0.0), 1.0);
+        // Most of the weight on 2: it is the median and the 70th percentile.
+        let heavy = [1.0, 1.0, 1.0, 10.0, 1.0];
+        assert_eq!(weighted_quantile(&values, &heavy, 0.5), 2.0);
+        assert_eq!(weighted_quantile(&values, &heavy, 0.7), 2.0);
+        assert_eq!(weighted_quantile(&values, &heavy, 0.95), 5.0);
+    }
 
     /// The unit cube in twelve triangles: its twelve edges are sharp (90°), its six face diagonals
     /// are not; and the distance to them is the distance to the cube's edges, at random points

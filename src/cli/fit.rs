@@ -266,6 +266,7 @@ fn as_fitted<'a>(
         positions,
         triangles,
         intended_normals: None,
+        flat_faces: None,
         rms_residual: fit.rms_residual,
         max_residual: fit.max_residual,
         mesh_diagonal: fit.mesh_diagonal,

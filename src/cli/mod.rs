@@ -95,8 +95,8 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 /// The spline and the fit's weight, as `new` and `fit` take them.
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct FitArgs {
-    /// Control points per side of each chart's grid [default: for new 32 up to genus 2 and 48 from
-    /// genus 3 (a coarser grid ripples there); for fit 40, and 80 for a genus-0 mesh (its two
+    /// Control points per side of each chart's grid [default: for new 32 for the sphere and the
+    /// torus and 48 from genus 2 (a coarser grid ripples there); for fit 40, and 80 for a genus-0 mesh (its two
     /// charts carry the whole surface); 32 for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=MAX_GRID))]
     grid: Option<u64>,

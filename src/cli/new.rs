@@ -261,6 +261,23 @@ pub struct ShapeReport {
     /// [`DISTANCE_SAMPLES`], or finer up to [`FINEST_DISTANCE_SAMPLES`] where its edges are longer
     /// than the input's ([`embedding::quality::hausdorff_to_mesh_resolved`]).
     pub distance_samples: u32,
+    /// On a plate's flat faces (`new`'s plates of genus 2 and up), where the intended surface is
+    /// a plane: how far the surface bends and turns there (a ripple). Reported, not gated.
+    pub flat_faces: Option<FlatFacesReport>,
+}
+
+/// [`ShapeReport::flat_faces`]: the mean curvature |H| (model units⁻¹) at the input's vertices on
+/// the plate's flat faces, median and 90th percentile weighted by their areas; the 90th
+/// percentile times the plate's half-thickness (dimensionless: issue 12 asks for at most 0.02);
+/// the normal's angle from ±z at the 90th percentile, in degrees.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct FlatFacesReport {
+    pub vertices: usize,
+    pub half_thickness: f64,
+    pub mean_curvature_median: f64,
+    pub mean_curvature_p90: f64,
+    pub mean_curvature_p90_times_half_thickness: f64,
+    pub normal_p90: f64,
 }
 
 /// The coarsest tessellation (t_e = t_r) the distance to the input is measured from.
@@ -340,6 +357,29 @@ fn measure_shape(
         coarse_crossings: if crossings.len() > 1 { first.1 } else { 0 },
         distance_to_input: distance.symmetric / diagonal,
         distance_samples,
+        flat_faces: fitted.flat_faces.and_then(|f| flat_faces(fitted, f)),
+    })
+}
+
+/// [`FlatFacesReport`] for the plate's faces `faces`.
+fn flat_faces(fitted: &Fitted, faces: PlateFaces) -> Option<FlatFacesReport> {
+    let areas = embedding::fit::vertex_areas(fitted.positions, fitted.triangles);
+    let at = &fitted.parameterization.points;
+    let points: Vec<_> = faces.vertices.iter().map(|&i| at[i]).collect();
+    let weights: Vec<f64> = faces.vertices.iter().map(|&i| areas[i]).collect();
+    let normals: Vec<_> = faces
+        .vertices
+        .iter()
+        .map(|&i| embedding::Vector3::new(0.0, 0.0, fitted.positions[i].z.signum()))
+        .collect();
+    let flat = embedding::quality::flat_faces(fitted.surface, &points, &normals, &weights)?;
+    Some(FlatFacesReport {
+        vertices: flat.points,
+        half_thickness: faces.half_thickness,
+        mean_curvature_median: flat.mean_curvature_median,
+        mean_curvature_p90: flat.mean_curvature_p90,
+        mean_curvature_p90_times_half_thickness: flat.mean_curvature_p90 * faces.half_thickness,
+        normal_p90: flat.normal_p90,
     })
 }
 
@@ -418,11 +458,21 @@ pub struct Fitted<'a> {
     /// The intended shape's exact normals at the mesh's vertices, where known (`new`'s plates); the
     /// normal deviation is measured against them, and otherwise against the mesh's own.
     pub intended_normals: Option<&'a [embedding::Vector3]>,
+    /// A plate's flat faces, where known (`new`'s plates of genus 2 and up).
+    pub flat_faces: Option<PlateFaces<'a>>,
     pub rms_residual: f64,
     pub max_residual: f64,
     pub mesh_diagonal: f64,
     pub settings: SplineSettings,
     pub smoothness: f64,
+}
+
+/// A plate's flat faces: the input's vertices on them (`embedding::holed::HoledMesh::flat_vertices`)
+/// and the plate's half-thickness.
+#[derive(Clone, Copy)]
+pub struct PlateFaces<'a> {
+    pub vertices: &'a [usize],
+    pub half_thickness: f64,
 }
 
 /// The checks and measures of a fit (`ntori new` and `ntori fit` alike): folds, residual,
@@ -439,6 +489,7 @@ pub fn check(
         positions,
         triangles,
         intended_normals: _,
+        flat_faces: _,
         rms_residual,
         max_residual,
         mesh_diagonal,
@@ -513,6 +564,7 @@ pub fn make(
         max_residual,
         mesh_diagonal,
     } = initial_model_with_progress(genus, resolution, settings, fit, &|s| progress.fit_stage(s))?;
+    let flat_vertices = mesh.flat_vertices();
     let checked = Fitted {
         surface: &surface,
         genus,
@@ -520,6 +572,11 @@ pub fn make(
         positions: &mesh.positions,
         triangles: &mesh.triangles,
         intended_normals: Some(&mesh.normals),
+        flat_faces: Some(PlateFaces {
+            vertices: &flat_vertices,
+            half_thickness: mesh.thickness,
+        })
+        .filter(|f| !f.vertices.is_empty()),
         rms_residual,
         max_residual,
         mesh_diagonal,
@@ -536,6 +593,21 @@ pub fn make(
 }
 
 impl NewReport {
+    /// A plate's flat faces, as a line of their own (else nothing).
+    fn flat_faces_text(&self) -> String {
+        self.shape.flat_faces.map_or(String::new(), |f| {
+            format!(
+                "flat faces: |H| {:.4} median, {:.4} at 90% (times the half-thickness {}: {:.4}); \
+                 normals {:.2}° off ±z (90%)\n",
+                f.mean_curvature_median,
+                f.mean_curvature_p90,
+                f.half_thickness,
+                f.mean_curvature_p90_times_half_thickness,
+                f.normal_p90
+            )
+        })
+    }
+
     /// Where the input has sharp edges, how the curvature check treats them, in words (else
     /// nothing).
     fn crease_text(&self) -> String {
@@ -601,7 +673,7 @@ impl NewReport {
              patches: disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%) ({pdv})\n\
              curvature: largest |κ| {kmax:.2}, {ratio:.2}× the input's {kin:.2}{creases} ({kv})\n\
              normals: {nmed:.2}° from the {reference} (90%: {n90:.2}°) ({nv})\n\
-             self-intersections: {crossings} crossing triangle pairs at t_e = t_r = {t} ({ev}){coarse}\n\
+             {flat}self-intersections: {crossings} crossing triangle pairs at t_e = t_r = {t} ({ev}){coarse}\n\
              area {area:.4}, {secs:.2} s\n",
             genus = self.genus,
             degree = self.settings.degree,
@@ -639,6 +711,7 @@ impl NewReport {
             },
             n90 = self.shape.normal_deviation_p90,
             nv = verdict(self.shape_verdict.normals),
+            flat = self.flat_faces_text(),
             crossings = self.shape.self_intersections,
             t = self.shape.intersection_samples,
             ev = verdict(self.shape_verdict.embedded),

@@ -410,19 +410,47 @@ fn a_grid_far_finer_than_the_data_is_still_solved() {
     );
 }
 
-/// The grid is finer from genus 3 on, where 32 ripples (see `default_grid`'s measurements), and a
+/// The default genus-2 plate's flat faces lie flat: issue 12 asks for |H| times the plate's
+/// thickness at most 0.02 at the 90th percentile (here its half-thickness, `HoledMesh::thickness`).
+/// At the old default grid of 32 they read 0.0292 and the normals 0.51° off ±z; at 48 0.0125 and
+/// 0.17°.
+#[test]
+fn the_default_genus_2_plates_flat_faces_lie_flat() {
+    use embedding::fit::{default_resolution, default_settings, vertex_areas};
+    let (spline, settings) = default_settings(2);
+    let fit = initial_model(2, default_resolution(2).unwrap(), spline, settings).unwrap();
+    let mesh = &fit.mesh;
+    let flat = mesh.flat_vertices();
+    let areas = vertex_areas(&mesh.positions, &mesh.triangles);
+    let points: Vec<_> = flat
+        .iter()
+        .map(|&i| fit.parameterization.points[i])
+        .collect();
+    let normals: Vec<_> = flat.iter().map(|&i| mesh.normals[i]).collect();
+    let weights: Vec<f64> = flat.iter().map(|&i| areas[i]).collect();
+    let faces = embedding::quality::flat_faces(&fit.surface, &points, &normals, &weights).unwrap();
+    eprintln!("{faces:?}");
+    assert_eq!(faces.points, flat.len());
+    assert!(
+        faces.mean_curvature_p90 * mesh.thickness <= 0.02,
+        "{faces:?}"
+    );
+    assert!(faces.normal_p90 < 0.3, "{faces:?}");
+}
+
+/// The grid is finer from genus 2 on, where 32 ripples (see `default_grid`'s measurements), and a
 /// finer grid gets a stronger smoothness weight unless one is chosen.
 #[test]
-fn the_default_grid_is_32_up_to_genus_2_and_finer_above_with_more_smoothing() {
+fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smoothing() {
     use embedding::fit::{FINE_GRID, default_grid, default_settings, default_smoothness};
-    for genus in 0..=2 {
+    for genus in 0..=1 {
         assert_eq!(
             default_grid(genus),
             SplineSettings::default().grid,
             "genus {genus}"
         );
     }
-    for genus in [3, 5, 10, 16, 21, 24, 32, 64] {
+    for genus in [2, 3, 5, 10, 16, 21, 24, 32, 64] {
         assert_eq!(default_grid(genus), FINE_GRID, "genus {genus}");
     }
     assert!(FINE_GRID > SplineSettings::default().grid);
