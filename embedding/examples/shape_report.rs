@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use embedding::SplineSettings;
 use embedding::fit::{
-    FitSettings, default_disk_grid, default_grid, default_smoothness, initial_model,
+    FitSettings, default_disk_grid, default_grid, default_plate_smoothness, initial_model,
     plate_surface_smoothness,
 };
 use embedding::quality::{
@@ -46,7 +46,10 @@ fn main() {
         };
         let settings = FitSettings {
             patch_weight: setting("NTORI_PATCH_WEIGHT", defaults.patch_weight),
-            smoothness: setting("NTORI_SMOOTHNESS", default_smoothness(spline.grid)),
+            smoothness: setting(
+                "NTORI_SMOOTHNESS",
+                default_plate_smoothness(genus, spline.grid),
+            ),
             stretch_rounds: setting("NTORI_STRETCH_ROUNDS", defaults.stretch_rounds as f64)
                 as usize,
             surface_smoothness: setting(

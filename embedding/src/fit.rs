@@ -479,6 +479,48 @@ pub fn default_smoothness(grid: usize) -> f64 {
     }
 }
 
+/// The smoothness weight λ for `ntori new`'s plate of `genus` on a grid of `grid` where none is
+/// chosen: [`PLATE_SMOOTHNESS`] on grids finer than 32 up to genus [`PLATE_SMOOTHNESS_UP_TO`],
+/// [`default_smoothness`] otherwise.
+pub fn default_plate_smoothness(genus: u32, grid: usize) -> f64 {
+    if genus <= PLATE_SMOOTHNESS_UP_TO && grid > SplineSettings::default().grid {
+        PLATE_SMOOTHNESS
+    } else {
+        default_smoothness(grid)
+    }
+}
+
+/// The highest genus whose plate takes [`PLATE_SMOOTHNESS`]. `ntori new`'s largest |κ| (over the
+/// Gauss–Bonnet quadrature's points too) against the input's, 2e-3 → 1e-2: genus 5 1.23× →
+/// 1.14×, 8 1.27× → 1.25×, but 10 1.28× → 1.31×, 16 1.48× → 1.49×, 24 2.01× → 2.10× and 32
+/// 2.88× → 2.92× (its check allows 3×), the peaks on the outer rim where an edge chart's patch
+/// fades out, which the stronger weight does not reach.
+pub const PLATE_SMOOTHNESS_UP_TO: u32 = 9;
+
+/// The plates' smoothness weight on grids finer than 32 up to genus 9
+/// ([`default_plate_smoothness`]), five times [`default_smoothness`]'s 2e-3 there. At 2e-3 genus 2's eased rims round the holes carried
+/// fanned streaks of mean curvature along the input's rim vertices (32 round each hole), which
+/// 1e-2 smooths away (pictures looked at, shaded and in mean curvature; a finer input mesh did
+/// the same, 40 round each hole, but took the fit past issue 12's 1 s). Measured with the
+/// shape_report example (largest |κ|, normals from the intended shape at the 90th percentile,
+/// the flat faces' |H| times the half-thickness at the 90th percentile; patches within 0.005% of
+/// the diagonal of what they were; the same time):
+///
+/// | genus | λ = 2e-3 | λ = 1e-2 |
+/// |---|---|---|
+/// | 2 | 4.60, 0.31°, 0.0125 | 4.37, 0.28°, 0.0131 |
+/// | 3 | 4.71, 0.23°, 0.0119 | 4.55, 0.19°, 0.0112 |
+/// | 5 | 4.61, 0.22°, 0.0141 | 4.44, 0.20°, 0.0128 |
+/// | 10 | 4.89, 0.28°, 0.0175 | 4.91, 0.27°, 0.0164 |
+/// | 16 | 5.22, 0.30°, 0.0181 | 5.22, 0.32°, 0.0182 |
+/// | 24 | 6.36, 0.37°, 0.0188 | 5.87, 0.38°, 0.0175 |
+/// | 32 | 7.84, 0.39°, 0.0165 | 7.27, 0.39°, 0.0130 |
+///
+/// At genus 2, 5e-2 went too far (patches 0.034% → 0.068%, flat faces 0.0159). The largest |κ|
+/// here is over a t = 32 tessellation's vertices; `ntori new`'s, over the Gauss–Bonnet
+/// quadrature's points too, rose from genus 10 on, which keep 2e-3 ([`PLATE_SMOOTHNESS_UP_TO`]).
+pub const PLATE_SMOOTHNESS: f64 = 1e-2;
+
 /// `ntori new`'s spline and fit settings for `genus` where none are chosen: the default degree and
 /// continuity, [`default_grid`], [`default_disk_grid`], and that grid's fit settings
 /// ([`FitSettings::for_plate`]).
@@ -555,10 +597,15 @@ impl FitSettings {
         }
     }
 
-    /// [`FitSettings::for_grid`] for `ntori new`'s plate of `genus`: the smoothness term in arc
-    /// length where [`plate_surface_smoothness`] says ([`FitSettings::plate_smoothness`]).
+    /// The defaults for `ntori new`'s plate of `genus` on a grid of `grid`: the weight
+    /// [`default_plate_smoothness`], its term in arc length where [`plate_surface_smoothness`]
+    /// says ([`FitSettings::plate_smoothness`]).
     pub fn for_plate(genus: u32, grid: usize) -> FitSettings {
-        FitSettings::for_grid(grid).plate_smoothness(genus, grid)
+        FitSettings {
+            smoothness: default_plate_smoothness(genus, grid),
+            ..FitSettings::default()
+        }
+        .plate_smoothness(genus, grid)
     }
 
     /// These settings with the smoothness term a plate of `genus` on a grid of `grid` is fitted

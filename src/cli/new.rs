@@ -88,7 +88,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (settings, fit) = spline.settings(genus, embedding::fit::default_grid(genus), |grid| {
         embedding::fit::default_disk_grid(genus, grid)
     })?;
-    let fit = fit.plate_smoothness(genus, settings.grid);
+    let fit = FitSettings {
+        smoothness: spline
+            .smoothness
+            .unwrap_or_else(|| embedding::fit::default_plate_smoothness(genus, settings.grid)),
+        ..fit
+    }
+    .plate_smoothness(genus, settings.grid);
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;
