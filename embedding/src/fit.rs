@@ -331,7 +331,7 @@ impl std::fmt::Display for FitStage {
 /// The input mesh's resolution where none is chosen (points round each hole).
 pub const DEFAULT_RESOLUTION: usize = 32;
 
-/// The finer resolution [`default_resolution`] gives genus 3 to 9 and 11 to 15
+/// The finer resolution [`default_resolution`] gives genus 3 to 9 and 11 to 16
 /// ([`FINE_RESOLUTION_GENERA`]).
 pub const FINE_RESOLUTION: usize = 40;
 
@@ -347,7 +347,7 @@ pub const TORUS_RESOLUTION: usize = 48;
 /// rims are sampled), and the time allows it. Genus 10 meets them at 32 (1.28×, flat faces'
 /// |H|·T 0.0175 at the 90th percentile) and keeps it: at 40 it reads 1.20× but takes 13.5 s
 /// against 10.7 s, past issue 12's 5 s for its fit (the bench's `initial_fit/10`: 4.7 s at 32).
-pub const FINE_RESOLUTION_GENERA: [std::ops::RangeInclusive<u32>; 2] = [3..=9, 11..=15];
+pub const FINE_RESOLUTION_GENERA: [std::ops::RangeInclusive<u32>; 2] = [3..=9, 11..=16];
 
 /// The control grid `ntori new` uses for `genus` where none is chosen: the default 32
 /// ([`SplineSettings::default`]) for the sphere and the torus, 48 from genus 2 on (with
@@ -621,7 +621,7 @@ impl FitSettings {
 }
 
 /// The resolution `ntori new` and the editor use for `genus`: [`TORUS_RESOLUTION`] for the torus,
-/// [`FINE_RESOLUTION`] for genus 3 to 9 and 11 to 15, [`DEFAULT_RESOLUTION`] for the others, or
+/// [`FINE_RESOLUTION`] for genus 3 to 9 and 11 to 16, [`DEFAULT_RESOLUTION`] for the others, or
 /// where that mesh has more than [`DEFAULT_FIT_TRIANGLES`] (genus 24 and 32, not 16), nearly the
 /// finest within it (the plates' triangles grow as the resolution's square): genus 24 gets 28, 32
 /// gets 21. Where even resolution 8 has more, 8 (genus 64: 223 516 triangles, within
@@ -659,9 +659,13 @@ impl FitSettings {
 /// | 15 | 1.55× → 1.49× | 0.40° → 0.24° | 19.9 → 28.8 s |
 ///
 /// and the flat faces' |H|·T at the 90th percentile (shape_report) at genus 12 0.0265 → 0.0185,
-/// at 14 0.0269 → 0.0172. From genus 16 the plates are coarse enough for 32 (1.48×) and the time
-/// is larger. A finer mesh only near the rims (the flat faces at 1.5 or 2 times the
-/// rims' spacing) was tried: it kept the curvature gain at genus 5 (1.33×) at the time of
+/// at 14 0.0269 → 0.0172. Genus 16 (the grids' term) takes 40 too: its largest |κ| sat on the
+/// outer rim inside one edge chart (blend 0.99997) at 1.48–1.49× the input's; at 40 it reads
+/// 1.32×, normals 0.30° → 0.22° at the 90th percentile, flat faces' |H|·T 0.0182 → 0.0149, in
+/// 24.2 s against 17.8 s and 1.5 GB against 1.3 GB (172 100 triangles, within
+/// [`DEFAULT_FIT_TRIANGLES`]). Genus 20 at 32 read 1.79×, and at 40 1.63× (252 692 triangles,
+/// past the budget), so from 17 the plates keep 32, or less where the budget says. A finer mesh
+/// only near the rims (the flat faces at 1.5 or 2 times the rims' spacing) was tried: it kept the curvature gain at genus 5 (1.33×) at the time of
 /// resolution 32, but the flat faces rippled (|H|·T 0.044–0.061), and genus 32 with rims at 32
 /// read 3.66× against 3.37× (its peak is not on a rim's samples).
 pub fn default_resolution(genus: u32) -> Result<usize, EmbeddingError> {
