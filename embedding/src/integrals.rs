@@ -59,7 +59,7 @@ const NODES: [(f64, f64); 4] = [
 /// across a chart (8 per interval of a 16-point cubic grid gave 104), and at least 2 per interval:
 /// the blends and the chart maps, not only the spline's knots, set how fine the rule must be, so a
 /// finer grid needs no more cells across a chart. `ntori new`'s Gauss–Bonnet check uses it. At grid
-/// 32 it gives 4 (116 cells across); measured on the default genus-2 and genus-8 plates there, ∫K dA
+/// 32 it gives 4 (116 cells across); measured on the genus-2 and genus-8 plates at that grid, ∫K dA
 /// is within 3e-6 relative of 2π(2 − 2n) at 4 cells per knot, as at 8. At grid 48 it gives 3 (135
 /// across): the genus-10 and genus-16 plates read 5.8e-6 and 9.4e-6 there, 1e-8 and 5.4e-6 at 4,
 /// and at 2 (90 across, what rounding down gave) 2.1e-5 and 6.9e-5, which failed issue 12's 1e-5

@@ -122,10 +122,11 @@ impl LeastSquares {
             rows,
             cols,
             nonzeros = triplets.len(),
-            built_seconds = built,
-            transposed_seconds = transposed,
-            formed_seconds = formed,
-            factored_seconds = start.elapsed().as_secs_f64() - formed,
+            // Each step's own time: Aᵀ, A, AᵀA, its factorization.
+            transpose_seconds = built,
+            a_seconds = transposed - built,
+            gram_seconds = formed - transposed,
+            factor_seconds = start.elapsed().as_secs_f64() - formed,
             "least squares factored"
         );
         Ok(LeastSquares {

@@ -300,22 +300,23 @@ pub struct FlatFaces {
 
 /// [`FlatFaces`] at `points`, where the intended surface is flat with normal `normals[i]` (any
 /// length), weighted by `weights` (e.g. the input's vertex areas). A point where the surface has
-/// no normal or curvature counts as 180° and infinitely curved. `None` for no points.
+/// no normal or curvature counts as 180° and infinitely curved. `None` for no points, or where the
+/// three slices' lengths differ.
 pub fn flat_faces(
     surface: &Surface,
     points: &[ChartPoint],
     normals: &[Vector3],
     weights: &[f64],
 ) -> Option<FlatFaces> {
-    let n = points.len().min(normals.len()).min(weights.len());
-    if n == 0 {
+    let n = points.len();
+    if n == 0 || normals.len() != n || weights.len() != n {
         return None;
     }
     let mut angles = vec![180.0; n];
     let mut curvatures = vec![f64::INFINITY; n];
     evaluate::evaluate(
         surface,
-        &points[..n],
+        points,
         evaluate::Wants {
             curvature: true,
             ..Default::default()
@@ -332,7 +333,6 @@ pub fn flat_faces(
             }
         },
     );
-    let weights = &weights[..n];
     Some(FlatFaces {
         points: n,
         mean_curvature_median: weighted_quantile(&curvatures, weights, 0.5),

@@ -133,9 +133,9 @@ impl EditorApp {
             }
             Some(Err(e)) => {
                 app.messages.error(format!("cannot show the model: {e}"));
-                app.jobs.new_model(2, SplineSettings::default());
+                app.jobs.new_model(2, embedding::fit::default_settings(2).0);
             }
-            None => app.jobs.new_model(2, SplineSettings::default()),
+            None => app.jobs.new_model(2, embedding::fit::default_settings(2).0),
         }
         app
     }
