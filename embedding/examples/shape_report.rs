@@ -116,7 +116,6 @@ fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)
     for &i in &flat {
         is_flat[i] = true;
     }
-    let up = |z: f64| embedding::Vector3::new(0.0, 0.0, z.signum());
     let (points, (normals, weights)): (Vec<_>, (Vec<_>, Vec<f64>)) =
         if std::env::var("NTORI_CENTROIDS").is_ok() {
             let disk = fit.parameterization.disk.as_ref()?;
@@ -136,17 +135,12 @@ fn flat_faces(fit: &embedding::fit::InitialFit) -> Option<(f64, f64, f64, usize)
                         .atlas()
                         .locate_model(charts::ModelPoint(z))
                         .representations()[0];
-                    (point, (up(mesh.positions[original(t[0])].z), area))
+                    (point, (mesh.normals[original(t[0])], area))
                 })
                 .unzip()
         } else {
             flat.iter()
-                .map(|&i| {
-                    (
-                        fit.parameterization.points[i],
-                        (up(mesh.positions[i].z), areas[i]),
-                    )
-                })
+                .map(|&i| (fit.parameterization.points[i], (mesh.normals[i], areas[i])))
                 .unzip()
         };
     let f = embedding::quality::flat_faces(&fit.surface, &points, &normals, &weights)?;

@@ -120,12 +120,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             valid.genus,
             embedding::SplineSettings::default().grid,
             |_| None,
+            embedding::fit::default_smoothness,
         )?
     } else {
-        args.spline
-            .settings(valid.genus, mesh_fit_grid(valid.genus), |grid| {
-                mesh_fit_disk_grid(valid.genus, grid)
-            })?
+        args.spline.settings(
+            valid.genus,
+            mesh_fit_grid(valid.genus),
+            |grid| mesh_fit_disk_grid(valid.genus, grid),
+            embedding::fit::default_smoothness,
+        )?
     };
     fit.even_rounds = args.even_rounds as usize;
     fit.surface_smoothness = embedding::mesh_fit::surface_smoothness(valid.genus);

@@ -125,14 +125,16 @@ struct FitArgs {
 }
 
 impl FitArgs {
-    /// The settings asked for at `genus`; the grid is `default_grid` where none was given, and the
-    /// disk charts' grid `default_disk_grid` of the grid (`None`: the grid). Grids too large for a
-    /// fit are refused here ([`check_grid_size`]), before any work.
+    /// The settings asked for at `genus`; the grid is `default_grid` where none was given, the
+    /// disk charts' grid `default_disk_grid` of the grid (`None`: the grid), and the smoothness
+    /// weight `default_smoothness` of the grid. Grids too large for a fit are refused here
+    /// ([`check_grid_size`]), before any work.
     fn settings(
         &self,
         genus: u32,
         default_grid: usize,
         default_disk_grid: impl Fn(usize) -> Option<usize>,
+        default_smoothness: impl Fn(usize) -> f64,
     ) -> anyhow::Result<(SplineSettings, FitSettings)> {
         let grid = self.grid.map_or(default_grid, |g| g as usize);
         let disk_grid = self
@@ -150,7 +152,7 @@ impl FitArgs {
         let fit = FitSettings {
             smoothness: self
                 .smoothness
-                .unwrap_or_else(|| embedding::fit::default_smoothness(spline.grid)),
+                .unwrap_or_else(|| default_smoothness(spline.grid)),
             ..FitSettings::default()
         };
         Ok((spline, fit))

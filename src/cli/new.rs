@@ -88,16 +88,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         json,
         quiet,
     } = args;
-    let (settings, fit) = spline.settings(genus, embedding::fit::default_grid(genus), |grid| {
-        embedding::fit::default_disk_grid(genus, grid)
-    })?;
-    let fit = FitSettings {
-        smoothness: spline
-            .smoothness
-            .unwrap_or_else(|| embedding::fit::default_plate_smoothness(genus, settings.grid)),
-        ..fit
-    }
-    .plate_smoothness(genus, settings.grid);
+    let (settings, fit) = spline.settings(
+        genus,
+        embedding::fit::default_grid(genus),
+        |grid| embedding::fit::default_disk_grid(genus, grid),
+        |grid| embedding::fit::default_plate_smoothness(genus, grid),
+    )?;
+    let fit = fit.plate_smoothness(genus, settings.grid);
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;
@@ -370,17 +367,14 @@ fn measure_shape(
     })
 }
 
-/// [`FlatFacesReport`] for the plate's faces `faces`.
+/// [`FlatFacesReport`] for the plate's faces `faces`, against the intended normals there (±z).
 fn flat_faces(fitted: &Fitted, faces: PlateFaces) -> Option<FlatFacesReport> {
+    let intended = fitted.intended_normals?;
     let areas = embedding::fit::vertex_areas(fitted.positions, fitted.triangles);
     let at = &fitted.parameterization.points;
     let points: Vec<_> = faces.vertices.iter().map(|&i| at[i]).collect();
     let weights: Vec<f64> = faces.vertices.iter().map(|&i| areas[i]).collect();
-    let normals: Vec<_> = faces
-        .vertices
-        .iter()
-        .map(|&i| embedding::Vector3::new(0.0, 0.0, fitted.positions[i].z.signum()))
-        .collect();
+    let normals: Vec<_> = faces.vertices.iter().map(|&i| intended[i]).collect();
     let flat = embedding::quality::flat_faces(fitted.surface, &points, &normals, &weights)?;
     Some(FlatFacesReport {
         vertices: flat.points,
@@ -467,7 +461,8 @@ pub struct Fitted<'a> {
     /// The intended shape's exact normals at the mesh's vertices, where known (`new`'s plates); the
     /// normal deviation is measured against them, and otherwise against the mesh's own.
     pub intended_normals: Option<&'a [embedding::Vector3]>,
-    /// A plate's flat faces, where known (`new`'s plates of genus 2 and up).
+    /// A plate's flat faces, where known (`new`'s plates; none for the sphere and the torus),
+    /// measured against `intended_normals`.
     pub flat_faces: Option<PlateFaces<'a>>,
     pub rms_residual: f64,
     pub max_residual: f64,
@@ -584,8 +579,7 @@ pub fn make(
         flat_faces: Some(PlateFaces {
             vertices: &flat_vertices,
             half_thickness: mesh.thickness,
-        })
-        .filter(|f| !f.vertices.is_empty()),
+        }),
         rms_residual,
         max_residual,
         mesh_diagonal,
