@@ -31,7 +31,7 @@ fn main() {
         // NTORI_GRID, NTORI_DISK_GRID, NTORI_PATCH_WEIGHT, NTORI_SMOOTHNESS, NTORI_RESOLUTION and
         // NTORI_SURFACE_SMOOTHNESS (1 or 0)
         // override `ntori new`'s defaults, for tuning.
-        let defaults = FitSettings::for_plate(genus, default_grid(genus));
+        let defaults = FitSettings::for_plate(genus, embedding::fit::default_settings(genus).0);
         let setting = |name: &str, default: f64| {
             std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
         };

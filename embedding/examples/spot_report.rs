@@ -43,6 +43,29 @@ fn main() {
         jet.area_element(),
         jet.normal()
     );
+    if std::env::var("NTORI_LINE").is_ok() {
+        // The curvature along the peak chart's u and v lines through the peak.
+        for (name, dir) in [
+            ("u", Complex64::new(1.0, 0.0)),
+            ("v", Complex64::new(0.0, 1.0)),
+        ] {
+            let mut line = String::new();
+            for k in -12..=12 {
+                let q = ChartPoint::new(at.chart, at.coords + dir * (k as f64 * 0.004));
+                let j = layout.eval(control, q);
+                let (k1, k2) = j.principal_curvatures();
+                line += &format!(" {:.1}", k1.abs().max(k2.abs()));
+            }
+            println!("  |κ| along {name} (step 0.004, |E| {:.2}):{line}", {
+                let j = layout.eval(control, at);
+                if name == "u" {
+                    j.du.norm()
+                } else {
+                    j.dv.norm()
+                }
+            });
+        }
+    }
     let blends = layout.blends(at);
     let own = |p: ChartPoint| {
         let mut basis = Vec::new();
@@ -64,14 +87,30 @@ fn main() {
         let eu = (shift(Complex64::new(h, 0.0)) - shift(Complex64::new(-h, 0.0))) / (2.0 * h);
         let ev = (shift(Complex64::new(0.0, h)) - shift(Complex64::new(0.0, -h))) / (2.0 * h);
         let angle = (eu.dot(&ev) / (eu.norm() * ev.norm())).acos().to_degrees();
+        // The patch's own principal curvatures, from second differences in its coordinates.
+        let k = 1e-4;
+        let at_k = |du: f64, dv: f64| shift(Complex64::new(du * k, dv * k));
+        let euu = (at_k(1.0, 0.0) - e * 2.0 + at_k(-1.0, 0.0)) / (k * k);
+        let evv = (at_k(0.0, 1.0) - e * 2.0 + at_k(0.0, -1.0)) / (k * k);
+        let euv =
+            (at_k(1.0, 1.0) - at_k(1.0, -1.0) - at_k(-1.0, 1.0) + at_k(-1.0, -1.0)) / (4.0 * k * k);
+        let n = eu.cross(&ev).normalize();
+        let (ee, ff, gg) = (eu.dot(&eu), eu.dot(&ev), ev.dot(&ev));
+        let (l, m, nn) = (euu.dot(&n), euv.dot(&n), evv.dot(&n));
+        let det = ee * gg - ff * ff;
+        let h = (ee * nn - 2.0 * ff * m + gg * l) / (2.0 * det);
+        let kg = (l * nn - m * m) / det;
+        let disc = (h * h - kg).max(0.0).sqrt();
         println!(
-            "  chart {:?} at {:.4}: blend {b:.4}, patch {:.4?} (off the surface by {:.2e}), |E_u| {:.3e}, |E_v| {:.3e}, angle(E_u, E_v) {angle:.2}°",
+            "  chart {:?} at {:.4}: blend {b:.4}, patch {:.4?} (off the surface by {:.2e}), |E_u| {:.3e}, |E_v| {:.3e}, angle(E_u, E_v) {angle:.2}°, own κ {:.3} {:.3}",
             rep.chart,
             rep.coords,
             e,
             (e - jet.pos.coords).norm(),
             eu.norm(),
-            ev.norm()
+            ev.norm(),
+            h + disc,
+            h - disc
         );
     }
 }

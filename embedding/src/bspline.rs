@@ -42,6 +42,10 @@ impl UniformBasis {
     pub fn degree(&self) -> usize {
         self.degree
     }
+    /// The knot spacing (the domain is [−½, ½]).
+    pub fn spacing(&self) -> f64 {
+        self.h
+    }
     pub fn count(&self) -> usize {
         self.count
     }

@@ -249,6 +249,14 @@ pub struct FitSettings {
     /// smoothness (a user's mesh: [`crate::mesh_fit`]'s `smooth_enough`); off where the user
     /// chose λ.
     pub raise_smoothness: bool,
+    /// Weight of the agreement rows (0: none): where two charts' blends overlap, their own
+    /// patches are also made to agree with each other at a lattice of points between the data
+    /// ([`AGREEMENT_STEP`]), not only each with the data at the data's points (the patch terms).
+    /// Where the charts' supports barely overlap (the coverage margin falls with the genus) the
+    /// blend turns from one patch to the other within a fraction of the input's spacing, and its
+    /// derivatives times the patches' difference draw ridges of curvature along the fringe.
+    /// `new`'s plates take it from genus [`PLATE_AGREEMENT_FROM`] ([`FitSettings::for_plate`]).
+    pub agreement: f64,
 }
 
 impl Default for FitSettings {
@@ -262,6 +270,7 @@ impl Default for FitSettings {
             surface_smoothness: false,
             metric_coarsening: 1,
             raise_smoothness: false,
+            agreement: 0.0,
         }
     }
 }
@@ -279,13 +288,15 @@ pub struct InitialFit {
     pub mesh_diagonal: f64,
 }
 
-/// Peak memory of the initial fit per input triangle, measured with `ntori new` (release): 1.29 GB
-/// for genus 2's 169 556 triangles (resolution 128), 1.99 GB for genus 64's 223 516 (resolution
-/// 8); the map's sparse LU factorizations dominate. Rounded up. (With the fit's least squares by
-/// sparse QR, before the seminormal equations, it was 21 000: 3.56 GB for genus 2 at 128.)
-pub const FIT_BYTES_PER_TRIANGLE: u64 = 10_000;
-/// The most input triangles [`initial_model`] and [`crate::mesh_fit::mesh_model`] fit: about 4 GB
-/// at the rate above. Every genus up to 64 fits at resolution 8 (genus 64: 223 516 triangles).
+/// Peak memory of `ntori new` per input triangle (release): 1.29 GB for genus 2's 169 556
+/// triangles (resolution 128), where the map's sparse LU factorizations dominate; 4.4 GB for genus
+/// 64's 223 516 (resolution 8), where the disk charts' grids of 384 and the agreement rows add to
+/// the fit's (1.99 GB before them). Rounded up. (With the fit's least squares by sparse QR, before
+/// the seminormal equations, genus 2 at 128 took 3.56 GB.)
+pub const FIT_BYTES_PER_TRIANGLE: u64 = 20_000;
+/// The most input triangles [`initial_model`] and [`crate::mesh_fit::mesh_model`] fit: about 8 GB
+/// at the rate above (less at low genus). Every genus up to 64 fits at resolution 8 (genus 64:
+/// 223 516 triangles).
 pub const MAX_FIT_TRIANGLES: usize = 400_000;
 /// The most input triangles [`default_resolution`] chooses: the map's time grows faster than its
 /// size (genus 2: 0.65 s for 10 948 triangles, 6.8 s for 42 732, 100 s for 169 556 measured
@@ -415,8 +426,9 @@ pub fn default_grid(genus: u32) -> usize {
 pub const FINE_GRID: usize = 48;
 
 /// The disk charts' grid `ntori new` uses for `genus` and an edge-chart `grid` where none is
-/// chosen (`None`: the same as the edge charts'): twice `grid` from genus 3, 8/3 of it from genus
-/// 16 (96 and 128 at the default 48), rounded to a multiple of 8.
+/// chosen (`None`: the same as the edge charts'): twice `grid` from genus 3, 8/3 of it at genus
+/// 16, 16/3 from genus 17 and 8 times above genus 48 (96, 128, 256 and 384 at the default 48),
+/// rounded to a multiple of 8.
 ///
 /// The inside and vertex charts are each a disk about a point whose hyperbolic neighbourhood
 /// holds well over half the surface: the plate's bottom and top faces and, at their rims, the
@@ -442,10 +454,24 @@ pub const FINE_GRID: usize = 48;
 /// | 16 | 0.005%, 1.47×, 0.76°, 0.038 | 0.005%, 1.26×, 0.40° | 0.004%, 1.24×, 0.30° |
 /// | 32 | fails: Gauss–Bonnet 6.4e-2, 63× | | 0.015%, 1.89×, 0.47°; Gauss–Bonnet 3.2e-5 |
 ///
-/// From genus 32 it is 16/3 of the grid (256): with today's input mesh (21 points round each hole)
-/// genus 32 read 3.37× at 128, which fails `new`'s curvature check, and at 256 0.015%, 2.88×,
-/// 0.39°, Gauss–Bonnet 1.0e-6 (63 s and 2.4 GB against 52 s and 1.7 GB). Genus 48 reads
-/// Gauss–Bonnet 6.6e-5 at 256 (|κ| 21× the input's).
+/// From genus 17 it is 16/3 of the grid (256). Genus 32 (21 points round each hole) read 3.37×
+/// at 128, which fails `new`'s curvature check, and at 256 0.015%, 2.88×, 0.39°, Gauss–Bonnet
+/// 1.0e-6 (63 s and 2.4 GB against 52 s and 1.7 GB). Genus 48 reads Gauss–Bonnet 6.6e-5 at 256
+/// (|κ| 21× the input's). From genus 17 to 31 the 128 of genus 16 left the largest |κ| rising with
+/// the genus, and `new` refused genus 27, 28, 29 and 31 (`ntori new`, largest |κ| against the
+/// input's; the flat faces' |H|·T; time and memory on two cores, other work running):
+///
+/// | genus | disk grid 128 | 256 |
+/// |---|---|---|
+/// | 17 | 1.56×, 0.0179, 18 s, 1.4 GB | 1.41×, 0.0100, 23 s, 2.3 GB |
+/// | 20 | 1.79×, 0.0180, 24 s, 1.6 GB | 1.50×, 0.0091, 29 s, 2.4 GB |
+/// | 24 | 2.01×, 0.0188, 28 s, 1.6 GB | 1.70×, 0.0105, 30 s, 2.4 GB |
+/// | 28 | 3.31× (refused), 0.0180 | 3.09× (refused), 0.0128 |
+/// | 31 | 5.17× (refused), 0.0216 | 4.28× (refused), 0.0187 |
+///
+/// With 256 the agreement rows pay from genus 17 ([`plate_agreement`]), which bring 28 and 31
+/// within `new`'s check; at 128 they made the peaks worse. Genus 16 keeps 128: 256 left its largest
+/// |κ| where it was (1.33×) for 0.9 GB more, though its flat faces read 0.0075 against 0.0149.
 ///
 /// Above genus 48 it is 8 times the grid (384). Genus 64 at 256 read Gauss–Bonnet 2.7e-3 (issue
 /// 12 asks for 1e-3) and at 384 6.9e-4, in 174 s and 3.4 GB against 165 s and 2.4 GB (at 128
@@ -453,6 +479,8 @@ pub const FINE_GRID: usize = 48;
 /// mesh (10 points round each hole, 275k triangles) left both as they were (2.1e-3, 105×): the spot
 /// is where an edge chart's rim, sheared (its E_u and E_v 31° to 41° apart), blends with a disk
 /// chart whose cells span 60 to 150 model units per chart unit there, the two patches 0.03 apart.
+/// The agreement rows ([`plate_agreement`]) tie such patches together: at 384 with them genus 64
+/// reads 5.3×, Gauss–Bonnet 1.1e-5 and patches within 0.001% of the diagonal (78 s, 4.4 GB).
 ///
 /// Genus 2's disk charts keep the edge charts' grid: at 48 a disk grid of 64 smoothed the flat
 /// faces' |H|·T from 0.0125 to 0.0095 but took the fit from 0.9 to 1.1 s, past issue 12's 1 s (see
@@ -461,8 +489,8 @@ pub fn default_disk_grid(genus: u32, grid: usize) -> Option<usize> {
     let (num, den) = match genus {
         0..=2 => return None,
         3..=15 => (2, 1),
-        16..=31 => (8, 3),
-        32..=48 => (16, 3),
+        16 => (8, 3),
+        17..=48 => (16, 3),
         _ => (8, 1),
     };
     Some((grid * num).div_ceil(8 * den).max(1) * 8)
@@ -537,7 +565,7 @@ pub fn default_settings(genus: u32) -> (SplineSettings, FitSettings) {
         disk_grid: default_disk_grid(genus, grid),
         ..SplineSettings::default()
     };
-    (spline, FitSettings::for_plate(genus, spline.grid))
+    (spline, FitSettings::for_plate(genus, spline))
 }
 
 /// [`FitSettings::metric_coarsening`] for `new`'s plates.
@@ -603,15 +631,16 @@ impl FitSettings {
         }
     }
 
-    /// The defaults for `ntori new`'s plate of `genus` on a grid of `grid`: the weight
-    /// [`default_plate_smoothness`], its term in arc length where [`plate_surface_smoothness`]
-    /// says ([`FitSettings::plate_smoothness`]).
-    pub fn for_plate(genus: u32, grid: usize) -> FitSettings {
+    /// The defaults for `ntori new`'s plate of `genus` on the grids of `spline`: the weights
+    /// [`default_plate_smoothness`] and [`plate_agreement`], and the smoothness term's form
+    /// ([`FitSettings::plate_smoothness`]).
+    pub fn for_plate(genus: u32, spline: SplineSettings) -> FitSettings {
         FitSettings {
-            smoothness: default_plate_smoothness(genus, grid),
+            smoothness: default_plate_smoothness(genus, spline.grid),
+            agreement: plate_agreement(genus, spline),
             ..FitSettings::default()
         }
-        .plate_smoothness(genus, grid)
+        .plate_smoothness(genus, spline.grid)
     }
 
     /// These settings with the smoothness term a plate of `genus` on a grid of `grid` is fitted
@@ -623,6 +652,49 @@ impl FitSettings {
             metric_coarsening: PLATE_METRIC_COARSENING,
             ..self
         }
+    }
+}
+
+/// The lowest genus whose plate is fitted with agreement rows ([`plate_agreement`]).
+pub const PLATE_AGREEMENT_FROM: u32 = 17;
+
+/// The agreement rows' weight for `new`'s plates ([`plate_agreement`]). Genus 31 with disk grids of
+/// 256 (largest |κ| against the input's): 4.28× without, 2.19× at 0.1, 2.21× at 0.3, 2.54× at 1,
+/// 3.65× at 10; genus 28: 1.82× at 0.1, 1.81× at 0.3.
+pub const PLATE_AGREEMENT: f64 = 0.3;
+
+/// The agreement rows' weight ([`FitSettings::agreement`]) for `ntori new`'s plate of `genus` on
+/// the grids of `spline`: [`PLATE_AGREEMENT`] from genus [`PLATE_AGREEMENT_FROM`] where the disk
+/// charts' grid is at least five times the edge charts' (as [`default_disk_grid`] makes it from
+/// genus 17), none otherwise.
+///
+/// From genus 17 the charts' supports overlap by a coverage margin of 0.024 chart units or less
+/// (0.018 at genus 24, 0.014 at 31 and 32, 0.007 at 64: `charts::scales`). Where a plate's rim
+/// crosses such a fringe, the blend turns from a disk chart's patch to an edge chart's within a
+/// few hundredths of a model unit, less than the input's spacing there, and the two patches, each
+/// fitted to the data only at the data's points, part between them by a few thousandths: the
+/// blend's second derivative times that gap drew a ridge of curvature along the fringe, a few
+/// hundredths wide (the spot_report example, `NTORI_LINE=1`: at genus 31, |κ| 1.6 → 16.4 → 1.6
+/// across it, each patch's own |κ| 4.4 and 1.3). The agreement rows tie the patches together
+/// between the data. With disk grids coarser than that the disk charts' cells span the rim's
+/// rounding there, and tying the edge charts' patches to them made it worse (genus 24 at 128:
+/// 2.01× → 3.92×, 31: 5.17× → 6.07×). Measured with `ntori new` (largest |κ| against the
+/// input's; `new` refuses above 3×):
+///
+/// | genus | disk grid 128 (8/3 of 48) | 256 | 256 with agreement 0.3 |
+/// |---|---|---|---|
+/// | 24 | 2.01× | 1.70× | 1.61× |
+/// | 28 | 3.31× (refused) | 3.09× (refused) | 1.81× |
+/// | 31 | 5.17× (refused) | 4.28× (refused) | 2.21× |
+/// | 32 | — | 2.88× | 2.30× |
+/// | 36 | — | 5.76× (refused) | 2.94× |
+///
+/// The patches' disagreement falls from 0.004–0.035% of the diagonal to 0.001–0.004%.
+pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
+    if genus >= PLATE_AGREEMENT_FROM && spline.disk_grid() >= 5 * spline.grid {
+        PLATE_AGREEMENT
+    } else {
+        0.0
     }
 }
 
@@ -1592,7 +1664,10 @@ pub fn fit(
         )));
     }
     let start = std::time::Instant::now();
-    let data = DataRows::new(layout, points, targets, weights, settings.patch_weight);
+    let mut data = DataRows::new(layout, points, targets, weights, settings.patch_weight);
+    if settings.agreement > 0.0 {
+        data.append_agreement(layout, settings.agreement);
+    }
     tracing::debug!(
         points = points.len(),
         controls = layout.control_count(),
@@ -1724,6 +1799,34 @@ impl DataRows {
         }
     }
 
+    /// The agreement rows ([`FitSettings::agreement`]) appended, with zero right-hand sides: at
+    /// the points of a lattice over each chart's fringe ([`AGREEMENT_STEP`] knot spacings apart,
+    /// within [`AGREEMENT_FRINGE`] of the chart's edge), for each pair of charts whose normalised
+    /// blends there are both at least [`AGREEMENT_MIN_BLEND`], √(weight b̂_c b̂_d) (E_c − E_d).
+    fn append_agreement(&mut self, layout: &Layout, weight: f64) {
+        let start = std::time::Instant::now();
+        let first = self.rhs.nrows();
+        let mut rows = first;
+        for chart in layout.atlas().charts() {
+            agreement_rows(layout, chart, weight, |pair| {
+                for &(c, v) in pair {
+                    self.triplets.push(Triplet::new(rows, c as usize, v));
+                }
+                rows += 1;
+            });
+        }
+        tracing::debug!(
+            rows = rows - first,
+            seconds = start.elapsed().as_secs_f64(),
+            "the fit's agreement rows built"
+        );
+        let mut rhs = Mat::<f64>::zeros(rows, 3);
+        rhs.as_mut()
+            .subrows_mut(0, first)
+            .copy_from(self.rhs.as_ref());
+        self.rhs = rhs;
+    }
+
     /// The control points fitting these rows with the smoothness rows `smooth` at weight λ
     /// (`smoothness`; [`DataRows::with_smoothness`]).
     fn solve(
@@ -1758,6 +1861,63 @@ impl DataRows {
             .subrows_mut(0, data_rows)
             .copy_from(self.rhs.as_ref());
         (rows, triplets, rhs)
+    }
+}
+
+/// The agreement rows' lattice spacing, in knot spacings of the chart it covers: two points per
+/// cell, so two patches cannot part between them by more than the cubic's bend over half a cell.
+pub const AGREEMENT_STEP: f64 = 0.5;
+
+/// How deep into a chart (its margin, chart units) the agreement rows' lattice reaches: where
+/// another chart's blend can still be steep. The coverage margins from genus 17 on are 0.024 and
+/// less (`charts::scales`), so this is several times the fringe.
+pub const AGREEMENT_FRINGE: f64 = 0.15;
+
+/// The smallest normalised blend of either chart of a pair that gets an agreement row. Below it the
+/// fainter patch barely shows in the surface, and its control points there, which the data hardly
+/// reach, would be dragged by rows they cannot follow (with every pair tied, however faint,
+/// genus 24's fit folded).
+pub const AGREEMENT_MIN_BLEND: f64 = 0.05;
+
+/// The agreement rows of the lattice over `chart`'s fringe, each handed to `row` as its entries
+/// (control point, value): E_c(p) − E_d(p) for each pair of charts c < d holding the lattice point
+/// p with normalised blends b̂_c, b̂_d ≥ [`AGREEMENT_MIN_BLEND`], scaled by √(weight b̂_c b̂_d).
+fn agreement_rows(
+    layout: &Layout,
+    chart: &charts::Chart,
+    weight: f64,
+    mut row: impl FnMut(&[(u32, f64)]),
+) {
+    let atlas = layout.atlas();
+    let step = AGREEMENT_STEP * layout.basis(chart.id()).spacing();
+    let n = (1.0 / step).ceil() as usize;
+    let (mut reps, mut entries, mut patch) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..=n {
+            let w = Complex64::new(-0.5 + i as f64 * step, -0.5 + j as f64 * step);
+            let margin = chart.domain().margin(w);
+            if margin <= 0.0 || margin > AGREEMENT_FRINGE {
+                continue;
+            }
+            atlas.locate_with_transitions_into(ChartPoint::new(chart.id(), w), &mut reps);
+            let blends = layout.blends_located(&reps);
+            for (a, &(ca, ba)) in blends.iter().enumerate() {
+                for &(cb, bb) in &blends[a + 1..] {
+                    if ba < AGREEMENT_MIN_BLEND || bb < AGREEMENT_MIN_BLEND {
+                        continue;
+                    }
+                    let scale = (weight * ba * bb).sqrt();
+                    entries.clear();
+                    for (c, sign) in [(ca, scale), (cb, -scale)] {
+                        let rep = reps.iter().find(|r| r.0.chart == c).expect("located").0;
+                        patch.clear();
+                        layout.patch_weights(rep, &mut patch);
+                        entries.extend(patch.iter().map(|&(k, v)| (k, sign * v)));
+                    }
+                    row(&entries);
+                }
+            }
+        }
     }
 }
 

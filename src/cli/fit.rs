@@ -121,6 +121,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             embedding::SplineSettings::default().grid,
             |_| None,
             embedding::fit::default_smoothness,
+            |_| 0.0,
         )?
     } else {
         args.spline.settings(
@@ -128,6 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             mesh_fit_grid(valid.genus),
             |grid| mesh_fit_disk_grid(valid.genus, grid),
             embedding::fit::default_smoothness,
+            |_| 0.0,
         )?
     };
     fit.even_rounds = args.even_rounds as usize;
@@ -162,6 +164,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let fitted = &user.fit;
     let (positions, triangles) = user.mesh(&valid.positions, &valid.triangles);
     let mut checked = as_fitted(fitted, positions, triangles, settings);
+    checked.agreement = fit.agreement;
     checked.intended_normals = cage.as_ref().map(|c| &c.normals[..]);
     let report = check(&checked, start, &|s| progress.stage(s))?;
     progress.finish();
@@ -275,6 +278,7 @@ fn as_fitted<'a>(
         mesh_diagonal: fit.mesh_diagonal,
         settings,
         smoothness: fit.smoothness.used,
+        agreement: 0.0,
     }
 }
 

@@ -102,7 +102,7 @@ struct FitArgs {
     grid: Option<u64>,
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
-    /// the grid from genus 3 (96 at 48), 8/3 of it from genus 16 (128), 16/3 from genus 32 (256)
+    /// the grid from genus 3 (96 at 48), 8/3 of it at genus 16 (128), 16/3 from genus 17 (256)
     /// and 8 times above genus 48 (384), the grid below genus 3; for fit twice the grid from genus
     /// 2 (80 at 40), the grid below; the grid for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=512))]
@@ -122,12 +122,19 @@ struct FitArgs {
     /// it where that leaves the surface rough]
     #[arg(long, value_name = "λ", value_parser = parse_smoothness)]
     smoothness: Option<f64>,
+    /// Weight of the rows that make overlapping charts' patches agree with each other between the
+    /// input's points, where both blends are at least 0.05 (0: none; relative to the data term)
+    /// [default: 0.3 for new's plates from genus 17, whose charts barely overlap, with disk grids
+    /// at least five times the grid; 0 otherwise]
+    #[arg(long, value_name = "W", value_parser = parse_agreement)]
+    agreement: Option<f64>,
 }
 
 impl FitArgs {
     /// The settings asked for at `genus`; the grid is `default_grid` where none was given, the
-    /// disk charts' grid `default_disk_grid` of the grid (`None`: the grid), and the smoothness
-    /// weight `default_smoothness` of the grid. Grids too large for a fit are refused here
+    /// disk charts' grid `default_disk_grid` of the grid (`None`: the grid), the smoothness
+    /// weight `default_smoothness` of the grid and the agreement weight `default_agreement` of
+    /// the grids. Grids too large for a fit are refused here
     /// ([`check_grid_size`]), before any work.
     fn settings(
         &self,
@@ -135,6 +142,7 @@ impl FitArgs {
         default_grid: usize,
         default_disk_grid: impl Fn(usize) -> Option<usize>,
         default_smoothness: impl Fn(usize) -> f64,
+        default_agreement: impl Fn(SplineSettings) -> f64,
     ) -> anyhow::Result<(SplineSettings, FitSettings)> {
         let grid = self.grid.map_or(default_grid, |g| g as usize);
         let disk_grid = self
@@ -153,6 +161,7 @@ impl FitArgs {
             smoothness: self
                 .smoothness
                 .unwrap_or_else(|| default_smoothness(spline.grid)),
+            agreement: self.agreement.unwrap_or_else(|| default_agreement(spline)),
             ..FitSettings::default()
         };
         Ok((spline, fit))
@@ -200,6 +209,24 @@ fn parse_smoothness(s: &str) -> Result<f64, String> {
     } else {
         Err(format!(
             "the smoothness weight must lie in (0, {MAX_SMOOTHNESS:e}], got {v}"
+        ))
+    }
+}
+
+/// The largest agreement weight `--agreement` takes: far past where it helps (at 10 genus 31's
+/// peak curvature was worse than at 0.3), but still a well-posed system.
+const MAX_AGREEMENT: f64 = 1e3;
+
+fn parse_agreement(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && (0.0..=MAX_AGREEMENT).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "the agreement weight must lie in [0, {MAX_AGREEMENT:e}], got {v}"
         ))
     }
 }

@@ -93,6 +93,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         embedding::fit::default_grid(genus),
         |grid| embedding::fit::default_disk_grid(genus, grid),
         |grid| embedding::fit::default_plate_smoothness(genus, grid),
+        |spline| embedding::fit::plate_agreement(genus, spline),
     )?;
     let fit = fit.plate_smoothness(genus, settings.grid);
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
@@ -194,6 +195,8 @@ pub struct NewReport {
     pub genus: u32,
     pub settings: SplineSettings,
     pub smoothness: f64,
+    /// The agreement rows' weight (`FitSettings::agreement`; 0: none).
+    pub agreement: f64,
     pub mesh_vertices: usize,
     pub mesh_triangles: usize,
     pub control_points: usize,
@@ -469,6 +472,7 @@ pub struct Fitted<'a> {
     pub mesh_diagonal: f64,
     pub settings: SplineSettings,
     pub smoothness: f64,
+    pub agreement: f64,
 }
 
 /// A plate's flat faces: the input's vertices on them (`embedding::holed::HoledMesh::flat_vertices`)
@@ -499,6 +503,7 @@ pub fn check(
         mesh_diagonal,
         settings,
         smoothness,
+        agreement,
     } = *fitted;
     stage("integrating the curvature");
     let layout = surface.layout();
@@ -517,6 +522,7 @@ pub fn check(
         genus,
         settings,
         smoothness,
+        agreement,
         mesh_vertices: positions.len(),
         mesh_triangles: triangles.len(),
         control_points: surface.control_points().len(),
@@ -585,6 +591,7 @@ pub fn make(
         mesh_diagonal,
         settings,
         smoothness: fit.smoothness,
+        agreement: fit.agreement,
     };
     let report = check(&checked, start, &|s| progress.stage(s))?;
     Ok(Made {

@@ -109,7 +109,7 @@ impl Jobs {
                 genus,
                 resolution,
                 settings,
-                FitSettings::for_plate(genus, settings.grid),
+                FitSettings::for_plate(genus, settings),
             )
             .map_err(fail)?;
             Ok(JobOutput::NewModel {

@@ -45,6 +45,8 @@ fn new_rejects_impossible_parameters() {
         vec!["--genus", "65"],
         vec!["--smoothness", "-1"],
         vec!["--smoothness", "NaN"],
+        vec!["--agreement", "-0.5"],
+        vec!["--agreement", "inf"],
         vec!["--grid", "2"],
         vec!["--resolution", "3"],
     ] {

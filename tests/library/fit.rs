@@ -410,6 +410,45 @@ fn a_grid_far_finer_than_the_data_is_still_solved() {
     );
 }
 
+/// The agreement rows tie overlapping patches together between the data: on a grid much finer
+/// than a coarse input mesh, the patches are free between its vertices and part; with the rows
+/// they agree, while the surface still passes through the data. Genus 3 and 5, resolution 8.
+#[test]
+fn agreement_rows_make_overlapping_patches_agree_between_the_data() {
+    use embedding::quality::{patch_disagreement, sample_points};
+    for genus in [3, 5] {
+        let spline = SplineSettings {
+            grid: 24,
+            ..SplineSettings::default()
+        };
+        let fit = |agreement: f64| {
+            let settings = FitSettings {
+                agreement,
+                ..FitSettings::for_grid(spline.grid)
+            };
+            let fit = initial_model(genus, 8, spline, settings).unwrap();
+            let points = sample_points(&fit.surface, 16).unwrap();
+            let apart = patch_disagreement(&fit.surface, &points, 0.1);
+            (apart, fit.max_residual / fit.mesh_diagonal)
+        };
+        let ((free, free_residual), (tied, tied_residual)) = (fit(0.0), fit(1.0));
+        eprintln!(
+            "genus {genus}: patches apart {:.2e} (rms {:.2e}) → {:.2e} (rms {:.2e}); residual {free_residual:.2e} → {tied_residual:.2e}",
+            free.max, free.rms, tied.max, tied.rms
+        );
+        assert!(free.compared > 1000 && tied.compared == free.compared);
+        assert!(
+            tied.rms < 0.5 * free.rms,
+            "genus {genus}: {free:?} → {tied:?}"
+        );
+        assert!(tied.max < free.max, "genus {genus}: {free:?} → {tied:?}");
+        assert!(
+            tied_residual < 2.0 * free_residual.max(1e-4),
+            "genus {genus}"
+        );
+    }
+}
+
 /// The default genus-2 plate's flat faces lie flat: issue 12 asks for |H| times the plate's
 /// thickness at most 0.02 at the 90th percentile (here its half-thickness, `HoledMesh::thickness`).
 /// At the old default grid of 32 they read 0.0292 and the normals 0.51° off ±z; at 48 (λ = 1e-2)
@@ -477,21 +516,21 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
                 expected,
                 "genus {genus}, grid {grid}"
             );
-            assert_eq!(FitSettings::for_plate(genus, grid).smoothness, expected);
+            let spline = SplineSettings {
+                grid,
+                ..SplineSettings::default()
+            };
+            assert_eq!(FitSettings::for_plate(genus, spline).smoothness, expected);
         }
     }
-    for genus in [0, 2, 3, 9, 10, 24] {
+    for genus in [0, 2, 3, 9, 10, 16, 17, 24, 32, 48, 64] {
         let (spline, fit) = default_settings(genus);
         assert_eq!(spline.grid, default_grid(genus), "genus {genus}");
         assert_eq!((spline.degree, spline.continuity), {
             let d = SplineSettings::default();
             (d.degree, d.continuity)
         });
-        assert_eq!(
-            fit,
-            FitSettings::for_plate(genus, spline.grid),
-            "genus {genus}"
-        );
+        assert_eq!(fit, FitSettings::for_plate(genus, spline), "genus {genus}");
         // The plates of genus 2 to 9 take the stronger weight on their fine grids.
         let expected = if (2..=9).contains(&genus) {
             embedding::fit::PLATE_SMOOTHNESS
@@ -501,7 +540,15 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
         assert_eq!(fit.smoothness, expected, "genus {genus}");
         // The arc-length term up to genus 15 on `new`'s grids, not on the assets' coarse ones.
         assert_eq!(fit.surface_smoothness, genus <= 15, "genus {genus}");
-        assert!(!FitSettings::for_plate(genus, 16).surface_smoothness);
+        let coarse = SplineSettings {
+            grid: 16,
+            disk_grid: None,
+            ..spline
+        };
+        assert!(!FitSettings::for_plate(genus, coarse).surface_smoothness);
+        // The agreement rows from genus 17, where the disk grids are fine enough for them.
+        assert_eq!(fit.agreement > 0.0, genus >= 17, "genus {genus}");
+        assert_eq!(FitSettings::for_plate(genus, coarse).agreement, 0.0);
     }
 }
 
