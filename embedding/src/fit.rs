@@ -427,7 +427,7 @@ pub const FINE_GRID: usize = 48;
 
 /// The disk charts' grid `ntori new` uses for `genus` and an edge-chart `grid` where none is
 /// chosen (`None`: the same as the edge charts'): twice `grid` from genus 3, 8/3 of it at genus
-/// 16, 16/3 from genus 17 and 8 times above genus 48 (96, 128, 256 and 384 at the default 48),
+/// 16, 16/3 from genus 17 and 8 times from genus 34 (96, 128, 256 and 384 at the default 48),
 /// rounded to a multiple of 8.
 ///
 /// The inside and vertex charts are each a disk about a point whose hyperbolic neighbourhood
@@ -473,7 +473,10 @@ pub const FINE_GRID: usize = 48;
 /// within `new`'s check; at 128 they made the peaks worse. Genus 16 keeps 128: 256 left its largest
 /// |κ| where it was (1.33×) for 0.9 GB more, though its flat faces read 0.0075 against 0.0149.
 ///
-/// Above genus 48 it is 8 times the grid (384). Genus 64 at 256 read Gauss–Bonnet 2.7e-3 (issue
+/// From genus 34 it is 8 times the grid (384): with the agreement rows, genus 34 to 39 read 3.1× to
+/// 4.1× at 256, which `new` refuses (3×), and 2.7× to 2.9× at 384 (34, 35, 37), for about 4.1 GB
+/// against 3 GB and 50 to 60 s; genus 40, 44 and 48 read 8.9×, 4.4× and 5.8× at 256 and 3.7×,
+/// 4.0× and 3.8× at 384 (40 at 512: 3.7×, 5.0 GB). Genus 64 at 256 read Gauss–Bonnet 2.7e-3 (issue
 /// 12 asks for 1e-3) and at 384 6.9e-4, in 174 s and 3.4 GB against 165 s and 2.4 GB (at 128
 /// 3.9e-2). Its largest |κ| stays about 110 times the input's at either grid, and a finer input
 /// mesh (10 points round each hole, 275k triangles) left both as they were (2.1e-3, 105×): the spot
@@ -490,7 +493,7 @@ pub fn default_disk_grid(genus: u32, grid: usize) -> Option<usize> {
         0..=2 => return None,
         3..=15 => (2, 1),
         16 => (8, 3),
-        17..=48 => (16, 3),
+        17..=33 => (16, 3),
         _ => (8, 1),
     };
     Some((grid * num).div_ceil(8 * den).max(1) * 8)
@@ -689,7 +692,17 @@ pub const PLATE_AGREEMENT: f64 = 0.3;
 /// | 32 | — | 2.88× | 2.30× |
 /// | 36 | — | 5.76× (refused) | 2.94× |
 ///
-/// The patches' disagreement falls from 0.004–0.035% of the diagonal to 0.001–0.004%.
+/// The patches' disagreement falls from 0.004–0.035% of the diagonal to 0.001–0.004%. From
+/// genus 18 to 23 the rows gain a little (18: 1.58× → 1.52×, 21: 1.66× → 1.64×, 23: 1.94× →
+/// 1.93×), but genus 20 loses (1.50× → 1.84×: its peak is in an edge chart's own patch, which the
+/// rows pull towards the vertex chart's just inside that chart's fade), and the flat faces' |H|·T
+/// rises by about a tenth (0.0097 → 0.0107 at genus 19); memory by 0.4 to 0.6 GB. Genus 36 takes
+/// disk grids of 384 ([`default_disk_grid`]): 2.71×.
+///
+/// A user's mesh (`ntori fit`) keeps none by default: on issue 14's test meshes weight 1 left them
+/// as they were or worse (the acceptance example: the cube with tunnels 3.10% → 4.17% of the
+/// diagonal off), though it brings the gear (`assets/meshes/gear-genus-1.obj`) within every check
+/// (patches 2.16% → 0.81% apart).
 pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
     if genus >= PLATE_AGREEMENT_FROM && spline.disk_grid() >= 5 * spline.grid {
         PLATE_AGREEMENT

@@ -103,7 +103,7 @@ struct FitArgs {
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
     /// the grid from genus 3 (96 at 48), 8/3 of it at genus 16 (128), 16/3 from genus 17 (256)
-    /// and 8 times above genus 48 (384), the grid below genus 3; for fit twice the grid from genus
+    /// and 8 times from genus 34 (384), the grid below genus 3; for fit twice the grid from genus
     /// 2 (80 at 40), the grid below; the grid for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=512))]
     disk_grid: Option<u64>,
