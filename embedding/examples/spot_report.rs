@@ -94,13 +94,15 @@ fn main() {
         let evv = (at_k(0.0, 1.0) - e * 2.0 + at_k(0.0, -1.0)) / (k * k);
         let euv =
             (at_k(1.0, 1.0) - at_k(1.0, -1.0) - at_k(-1.0, 1.0) + at_k(-1.0, -1.0)) / (4.0 * k * k);
-        let n = eu.cross(&ev).normalize();
-        let (ee, ff, gg) = (eu.dot(&eu), eu.dot(&ev), ev.dot(&ev));
-        let (l, m, nn) = (euu.dot(&n), euv.dot(&n), evv.dot(&n));
-        let det = ee * gg - ff * ff;
-        let h = (ee * nn - 2.0 * ff * m + gg * l) / (2.0 * det);
-        let kg = (l * nn - m * m) / det;
-        let disc = (h * h - kg).max(0.0).sqrt();
+        let (k1, k2) = embedding::SurfaceJet {
+            pos: embedding::Point3::from(e),
+            du: eu,
+            dv: ev,
+            duu: euu,
+            duv: euv,
+            dvv: evv,
+        }
+        .principal_curvatures();
         println!(
             "  chart {:?} at {:.4}: blend {b:.4}, patch {:.4?} (off the surface by {:.2e}), |E_u| {:.3e}, |E_v| {:.3e}, angle(E_u, E_v) {angle:.2}°, own κ {:.3} {:.3}",
             rep.chart,
@@ -109,8 +111,8 @@ fn main() {
             (e - jet.pos.coords).norm(),
             eu.norm(),
             ev.norm(),
-            h + disc,
-            h - disc
+            k1,
+            k2
         );
     }
 }

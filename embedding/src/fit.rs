@@ -1833,11 +1833,7 @@ impl DataRows {
             seconds = start.elapsed().as_secs_f64(),
             "the fit's agreement rows built"
         );
-        let mut rhs = Mat::<f64>::zeros(rows, 3);
-        rhs.as_mut()
-            .subrows_mut(0, first)
-            .copy_from(self.rhs.as_ref());
-        self.rhs = rhs;
+        self.rhs.resize_with(rows, 3, |_, _| 0.0);
     }
 
     /// The control points fitting these rows with the smoothness rows `smooth` at weight λ

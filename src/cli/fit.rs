@@ -163,8 +163,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
     let fitted = &user.fit;
     let (positions, triangles) = user.mesh(&valid.positions, &valid.triangles);
-    let mut checked = as_fitted(fitted, positions, triangles, settings);
-    checked.agreement = fit.agreement;
+    let mut checked = as_fitted(fitted, positions, triangles, settings, fit.agreement);
     checked.intended_normals = cage.as_ref().map(|c| &c.normals[..]);
     let report = check(&checked, start, &|s| progress.stage(s))?;
     progress.finish();
@@ -264,6 +263,7 @@ fn as_fitted<'a>(
     positions: &'a [embedding::Point3],
     triangles: &'a [[u32; 3]],
     settings: embedding::SplineSettings,
+    agreement: f64,
 ) -> Fitted<'a> {
     Fitted {
         surface: &fit.surface,
@@ -278,7 +278,7 @@ fn as_fitted<'a>(
         mesh_diagonal: fit.mesh_diagonal,
         settings,
         smoothness: fit.smoothness.used,
-        agreement: 0.0,
+        agreement,
     }
 }
 

@@ -199,11 +199,15 @@ const MAX_GRID: u64 = 160;
 const MAX_SMOOTHNESS: f64 = 1e6;
 
 /// λ: a number in (0, 1e6].
-fn parse_smoothness(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
+/// A number as a weight option takes it (surrounding spaces allowed), or what it is not.
+fn parse_number(s: &str) -> Result<f64, String> {
+    s.trim()
         .parse()
-        .map_err(|_| format!("{s:?} is not a number"))?;
+        .map_err(|_| format!("{s:?} is not a number"))
+}
+
+fn parse_smoothness(s: &str) -> Result<f64, String> {
+    let v = parse_number(s)?;
     if v.is_finite() && v > 0.0 && v <= MAX_SMOOTHNESS {
         Ok(v)
     } else {
@@ -218,10 +222,7 @@ fn parse_smoothness(s: &str) -> Result<f64, String> {
 const MAX_AGREEMENT: f64 = 1e3;
 
 fn parse_agreement(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("{s:?} is not a number"))?;
+    let v = parse_number(s)?;
     if v.is_finite() && (0.0..=MAX_AGREEMENT).contains(&v) {
         Ok(v)
     } else {
