@@ -41,7 +41,7 @@ fn main() {
         ("animal", shapes::animal(0.07 / scale)),
     ];
     if args.iter().any(|a| a == "--large") {
-        let plate = HoledMesh::new(4, 124).expect("a plate");
+        let plate = HoledMesh::new(4, 109).expect("a plate");
         cases.push(("genus-4 plate, large", (plate.positions, plate.triangles)));
     }
     let only = std::env::var("ONLY").ok();

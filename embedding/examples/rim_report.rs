@@ -1,5 +1,5 @@
 //! Where a plate model's outer rim leaves its intended profile: the t = 32 tessellation's points
-//! in the outer band (and just inside it), each one's distance from the flat face or the eased
+//! in the outer band (and just inside it), each one's distance from the flat face or the
 //! rim's cross-section, the largest per bin of angle. `ntori render`'s default pictures of the
 //! genus-10 and 16 plates show notches in the outer rim's silhouette; this measured the default
 //! genus-10 fit (grid 48) within 0.0033 of the intended rim everywhere (0.02% of the diagonal),
@@ -9,6 +9,7 @@
 use std::f64::consts::PI;
 
 use embedding::Surface;
+use embedding::holed::PlateLayout;
 use embedding::quality::sample_points;
 
 fn main() {
@@ -17,15 +18,10 @@ fn main() {
         serde_json::from_str(&std::fs::read_to_string(&path).expect("readable")).expect("a model");
     let surface = Surface::from_model(&model).expect("a surface");
     let n = surface.genus();
-    let sector = PI / f64::from(n);
-    let delta = 0.5 * sector;
-    let (r_hole, band, thickness) = (0.5, 0.35, 0.35);
-    let ring = 1.3f64
-        .max((r_hole + 0.15) / delta.sin())
-        .max((r_hole + 0.55) / sector.sin());
-    let r_outer = ring + r_hole + 0.9;
-    // The eased profile (across, drop) at t, as holed.rs draws it.
-    let angle = |t: f64| 0.5 * PI * t * t * (3.0 - 2.0 * t);
+    let plate = PlateLayout::new(n);
+    let (band, thickness, r_outer) = (plate.band, plate.thickness, plate.outer_radius);
+    // The rim's profile (across, drop) at t, as holed.rs draws it.
+    let angle = |t: f64| plate.rim_angle(t);
     let steps = 4000;
     let mut profile = Vec::with_capacity(steps + 1);
     let (mut x, mut z) = (0.0, 0.0);

@@ -532,9 +532,21 @@ pub fn default_plate_smoothness(genus: u32, grid: usize) -> f64 {
 /// fades out, which the stronger weight does not reach (genus 10 and 16 at resolution 32; at 40,
 /// genus 10's default now, 1.20× → 1.24×). Genus 9 is neutral (1.25× → 1.26×) and its normals
 /// improve (0.21° → 0.20° at the 90th percentile), like genus 2 to 8's.
-pub const PLATE_SMOOTHNESS_UP_TO: u32 = 9;
+///
+/// With the rims sampled finer across (`holed::RIM_REFINEMENT`) the data hold the rims more
+/// tightly, and at 2e-3 the flat faces beside them rippled more (genus 10, |H| × half-thickness
+/// at the 90th percentile over a t = 64 tessellation's points on the flat faces, the flat_report
+/// example: 0.0193 with the plain mesh, 0.0212 with the rings). So from then on genus 10 to 16
+/// take 1e-2 too; with the rings, 2e-3 → 1e-2 (`ntori new`'s largest |κ| against the input's,
+/// and flat_report's |H| × half-thickness at the 90th percentile):
+///
+/// | genus | 10 | 11 | 12 | 13 | 14 | 15 | 16 |
+/// |---|---|---|---|---|---|---|---|
+/// | \|κ\| | 1.14× → 1.16× | 1.19× → 1.19× | 1.20× → 1.23× | 1.25× → 1.26× | 1.29× → 1.32× | 1.40× → 1.43× | 1.23× → 1.24× |
+/// | flat faces | 0.0212 → 0.0197 | 0.0216 → 0.0197 | 0.0239 → 0.0230 | 0.0237 → 0.0227 | 0.0226 → 0.0223 | 0.0238 → 0.0233 | 0.0220 → 0.0209 |
+pub const PLATE_SMOOTHNESS_UP_TO: u32 = 16;
 
-/// The plates' smoothness weight on grids finer than 32 up to genus 9
+/// The plates' smoothness weight on grids finer than 32 up to genus 16
 /// ([`default_plate_smoothness`]), five times [`default_smoothness`]'s 2e-3 there. At 2e-3 genus 2's eased rims round the holes carried
 /// fanned streaks of mean curvature along the input's rim vertices (32 round each hole), which
 /// 1e-2 smooths away (pictures looked at, shaded and in mean curvature; a finer input mesh did
@@ -555,7 +567,8 @@ pub const PLATE_SMOOTHNESS_UP_TO: u32 = 9;
 ///
 /// At genus 2, 5e-2 went too far (patches 0.034% → 0.068%, flat faces 0.0159). The largest |κ|
 /// here is over a t = 32 tessellation's vertices; `ntori new`'s, over the Gauss–Bonnet
-/// quadrature's points too, rose from genus 10 on, which keep 2e-3 ([`PLATE_SMOOTHNESS_UP_TO`]).
+/// quadrature's points too, rose from genus 10 on, which kept 2e-3 until their rims were sampled
+/// finer ([`PLATE_SMOOTHNESS_UP_TO`]).
 pub const PLATE_SMOOTHNESS: f64 = 1e-2;
 
 /// `ntori new`'s spline and fit settings for `genus` where none are chosen: the default degree and
@@ -714,7 +727,7 @@ pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
 /// The resolution `ntori new` and the editor use for `genus`: [`TORUS_RESOLUTION`] for the torus,
 /// [`FINE_RESOLUTION`] for genus 3 to 16, [`DEFAULT_RESOLUTION`] for the others, or
 /// where that mesh has more than [`DEFAULT_FIT_TRIANGLES`] (genus 24 and 32, not 16), nearly the
-/// finest within it (the plates' triangles grow as the resolution's square): genus 24 gets 28, 32
+/// finest within it (the plates' triangles grow as the resolution's square): genus 24 gets 27, 32
 /// gets 21. Where even resolution 8 has more, 8 (genus 64: 223 516 triangles, within
 /// [`MAX_FIT_TRIANGLES`]).
 ///
@@ -753,7 +766,7 @@ pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
 /// at 14 0.0269 → 0.0172. Genus 16 (the grids' term) takes 40 too: its largest |κ| sat on the
 /// outer rim inside one edge chart (blend 0.99997) at 1.48–1.49× the input's; at 40 it reads
 /// 1.32×, normals 0.30° → 0.22° at the 90th percentile, flat faces' |H|·T 0.0182 → 0.0149, in
-/// 24.2 s against 17.8 s and 1.5 GB against 1.3 GB (172 100 triangles, within
+/// 24.2 s against 17.8 s and 1.5 GB against 1.3 GB (172 100 triangles; 189 516 with the rims' rings; within
 /// [`DEFAULT_FIT_TRIANGLES`]). Genus 20 at 32 read 1.79×, and at 40 1.63× (252 692 triangles,
 /// past the budget), so from 17 the plates keep 32, or less where the budget says. A finer mesh
 /// only near the rims (the flat faces at 1.5 or 2 times the rims' spacing) was tried: it kept the curvature gain at genus 5 (1.33×) at the time of

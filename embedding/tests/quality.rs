@@ -132,16 +132,16 @@ proptest! {
 
 #[test]
 fn a_plates_curvature_estimate_settles_as_its_mesh_refines() {
-    // The eased rims' curvature peaks at about 1.4 / T across the band (T the half-thickness), about
-    // 4 for the default plates. The estimate from the exact normals barely moves from resolution 24
-    // to 48.
+    // The smooth rims' curvature peaks at about 1.7 / T across the band (T the half-thickness),
+    // about 5 for the default plates (the eased rims' of genus 22 and up, 1.4 / T, about 4). The
+    // estimate from the exact normals barely moves from resolution 24 to 48.
     for genus in [2, 5] {
         let at = |resolution| {
             let mesh = HoledMesh::new(genus, resolution).unwrap();
             mesh_max_principal_curvature(&mesh.positions, &mesh.triangles, &mesh.normals)
         };
         let (coarse, fine) = (at(24), at(48));
-        assert!((3.0..5.0).contains(&fine), "genus {genus}: {fine}");
+        assert!((4.0..6.0).contains(&fine), "genus {genus}: {fine}");
         assert!(
             (coarse - fine).abs() < 0.03 * fine,
             "genus {genus}: {coarse} vs {fine}"
