@@ -7,7 +7,8 @@
 //! profile curve, so the two lifts meet smoothly along the circles. With one hole, a quarter circle
 //! and W = T = half the annulus width this is the round torus; with no hole and W = T = R it is the
 //! round sphere. A plate's rims ease in: their curvature rises from 0 at the flat faces, so the
-//! intended surface is curvature-continuous (G²) like the spline surface fitted to it.
+//! intended surface is curvature-continuous (G²) like the spline surface fitted to it; up to genus
+//! [`SMOOTH_RIMS_UP_TO`] it also rises without a slope (G³), which the fit follows more closely.
 //!
 //! A plate's bands are sampled finer across than its flat faces ([`RIM_REFINEMENT`]): the rims are
 //! where it bends.
@@ -116,7 +117,7 @@ struct Plan {
 }
 
 /// A plate's bands are sampled this many times finer across than the rest of the plan (rings of
-/// points [`band_points`], `h / 2` apart across the band and `h` along it), up to genus
+/// points (`band_points`), `h / 2` apart across the band and `h` along it), up to genus
 /// [`RIM_REFINEMENT_UP_TO`]. The rims are where the surface bends, and across them a plain mesh has
 /// about five vertices over the quarter turn: the fit, which goes through the vertices, followed
 /// that sampling (a serrated edge along the outer rim's band in a mean-curvature picture of genus
@@ -124,7 +125,7 @@ struct Plan {
 /// input's; two-sided Hausdorff distance to the input mesh; normals from the intended shape at the
 /// 90th percentile; flat faces' |H|·T at the 90th percentile; time), plain → refined, with the
 /// eased rims and λ = 2e-3 from genus 10 of the time (the flat faces' loss here is what
-/// [`Profile::Smooth`] and [`crate::fit::PLATE_SMOOTHNESS_UP_TO`] then took back):
+/// the smooth rims (`SMOOTH_RIMS_UP_TO`) and [`crate::fit::PLATE_SMOOTHNESS_UP_TO`] then took back):
 ///
 /// | genus | \|κ\| | Hausdorff | normals | flat faces | time |
 /// |---|---|---|---|---|---|
@@ -235,7 +236,9 @@ enum Profile {
     Smooth,
 }
 
-/// The last genus whose plate has [`Profile::Smooth`] rims (beyond, [`Profile::Eased`]). Measured
+/// The last genus whose plate has smooth rims (`Profile::Smooth`: φ = π/2 · (10t³ − 15t⁴ + 6t⁵),
+/// curvature rising from 0 without a slope, G³ where the faces meet the rims); beyond, eased ones
+/// (`Profile::Eased`: φ = π/2 · (3t² − 2t³), G²). Measured
 /// with `ntori new` (the rims sampled finer, [`RIM_REFINEMENT`]), eased → smooth: the flat
 /// faces' |H| × half-thickness at the 90th percentile at the input's vertices, and the largest
 /// |κ| against the input's (the smooth rims' own peak is a fifth higher):
@@ -374,7 +377,7 @@ impl PlateLayout {
     }
 
     /// The turn φ(t) of the rims' cross-section, t from 0 at the flat face to 1 at the circle
-    /// ([`Profile::Smooth`] up to genus [`SMOOTH_RIMS_UP_TO`], [`Profile::Eased`] beyond).
+    /// (smooth up to genus [`SMOOTH_RIMS_UP_TO`], eased beyond).
     pub fn rim_angle(&self, t: f64) -> f64 {
         plate_profile(self.genus).angle(t)
     }
