@@ -766,8 +766,8 @@ pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
 /// at 14 0.0269 → 0.0172. Genus 16 (the grids' term) takes 40 too: its largest |κ| sat on the
 /// outer rim inside one edge chart (blend 0.99997) at 1.48–1.49× the input's; at 40 it reads
 /// 1.32×, normals 0.30° → 0.22° at the 90th percentile, flat faces' |H|·T 0.0182 → 0.0149, in
-/// 24.2 s against 17.8 s and 1.5 GB against 1.3 GB (172 100 triangles; 189 516 with the rims' rings; within
-/// [`DEFAULT_FIT_TRIANGLES`]). Genus 20 at 32 read 1.79×, and at 40 1.63× (252 692 triangles,
+/// 24.2 s against 17.8 s and 1.5 GB against 1.3 GB (172 100 triangles, 189 516 with the rims'
+/// rings, within [`DEFAULT_FIT_TRIANGLES`]). Genus 20 at 32 read 1.79×, and at 40 1.63× (252 692 triangles,
 /// past the budget), so from 17 the plates keep 32, or less where the budget says. A finer mesh
 /// only near the rims (the flat faces at 1.5 or 2 times the rims' spacing) was tried: it kept the curvature gain at genus 5 (1.33×) at the time of
 /// resolution 32, but the flat faces rippled (|H|·T 0.044–0.061), and genus 32 with rims at 32

@@ -781,15 +781,27 @@ fn build(plan: &Plan, h: f64, genus: u32, resolution: usize) -> Result<HoledMesh
 /// along it, clear of the loops: the band is where the surface bends, so it is sampled finer.
 fn band_points(plan: &Plan, radial: f64, along: f64) -> Vec<P2> {
     let clearance = 0.5 * radial.min(along);
-    let near_loop = |q: P2| {
-        plan.loops.iter().flatten().any(|(_, line)| {
-            line.windows(2)
-                .any(|w| segment_distance(q, w[0], w[1]) < clearance)
-        })
-    };
+    let levels = (plan.band / radial).round() as usize;
+    let segments: Vec<[P2; 2]> = plan
+        .loops
+        .iter()
+        .flatten()
+        .flat_map(|(_, line)| line.windows(2).map(|w| [w[0], w[1]]))
+        .collect();
     let mut points = Vec::new();
     for c in &plan.circles {
-        let levels = (plan.band / radial).round() as usize;
+        // Only the loops' segments that come near this circle's band can be near its rings
+        // (checking every segment for every ring point was most of the meshing's time).
+        let (near, far) = (c.radius - plan.band, c.radius + plan.band);
+        let nearby: Vec<[P2; 2]> = segments
+            .iter()
+            .filter(|[a, b]| {
+                let closest = segment_distance(c.centre, *a, *b);
+                let farthest = dist(c.centre, *a).max(dist(c.centre, *b));
+                closest < far + clearance && farthest > near - clearance
+            })
+            .copied()
+            .collect();
         for level in 1..levels {
             let d = level as f64 * plan.band / levels as f64;
             let r = if c.hole { c.radius + d } else { c.radius - d };
@@ -797,14 +809,22 @@ fn band_points(plan: &Plan, radial: f64, along: f64) -> Vec<P2> {
             let offset = if level % 2 == 0 { 0.0 } else { 0.5 };
             for k in 0..count {
                 let q = polar(c.centre, r, TAU * (k as f64 + offset) / count as f64);
-                let clear = plan.circles.iter().all(|o| o.depth(q) > clearance);
-                if clear && !near_loop(q) {
+                let clear = plan.circles.iter().all(|o| o.depth(q) > clearance)
+                    && nearby
+                        .iter()
+                        .all(|[a, b]| segment_distance(q, *a, *b) >= clearance);
+                if clear {
                     points.push(q);
                 }
             }
         }
     }
     points
+}
+
+/// Distance between two plan points.
+fn dist(p: P2, q: P2) -> f64 {
+    (p[0] - q[0]).hypot(p[1] - q[1])
 }
 
 /// Distance from `q` to the segment from `a` to `b`.

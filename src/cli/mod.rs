@@ -198,7 +198,6 @@ const MAX_GRID: u64 = 160;
 /// term alone to f64 precision (λ = 1e308 overflowed into non-finite control points).
 const MAX_SMOOTHNESS: f64 = 1e6;
 
-/// λ: a number in (0, 1e6].
 /// A number as a weight option takes it (surrounding spaces allowed), or what it is not.
 fn parse_number(s: &str) -> Result<f64, String> {
     s.trim()
@@ -206,6 +205,7 @@ fn parse_number(s: &str) -> Result<f64, String> {
         .map_err(|_| format!("{s:?} is not a number"))
 }
 
+/// λ: a number in (0, 1e6].
 fn parse_smoothness(s: &str) -> Result<f64, String> {
     let v = parse_number(s)?;
     if v.is_finite() && v > 0.0 && v <= MAX_SMOOTHNESS {
