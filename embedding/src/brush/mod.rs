@@ -203,7 +203,8 @@ impl Symmetry {
                 .map(|&s| (Point3::from(at.coords.component_mul(&s)), s))
                 .collect();
             // The field's motion across each plane relative to its motion along it.
-            let (across, along) = image_weights(at, &centres, radius, falloff)
+            let (across, along) = ImageField::new(&centres, radius, falloff)
+                .weights(at)
                 .fold((Vector3::zeros(), 0.0), |(v, total), (k, w)| {
                     (v + centres[k].1 * w, total + w)
                 });
@@ -284,7 +285,8 @@ pub fn grab_shares(
 /// the surface, in [`Symmetry::images`]'s order) and for each control point that moves, its share
 /// of the displacement per axis: ΔP_c = share ⊙ Δ (the images move by the mirrored Δ, so along each
 /// axis the change is still a multiple of Δ's component). Where images' discs overlap they share
-/// the motion (see `image_weights`), so a point on a mirror plane moves once.
+/// the motion (see `ImageField`), so a point on a mirror plane moves once, and the picked point
+/// moves by Δ (limited as [`Symmetry::limit_grab`] says).
 pub fn grab_shares_mirrored(
     samples: &BrushSamples,
     centres: &[(Point3, Vector3)],
@@ -295,12 +297,13 @@ pub fn grab_shares_mirrored(
     let Some(reach) = Reach::new(samples, &only, radius)? else {
         return Ok(Vec::new());
     };
+    let field = ImageField::new(centres, radius, falloff);
     let targets: Vec<Vector3> = reach
         .samples
         .iter()
         .map(|&r| {
-            let x = samples.positions[r as usize];
-            image_weights(x, centres, radius, falloff)
+            field
+                .weights(samples.positions[r as usize])
                 .map(|(k, w)| centres[k].1 * w)
                 .sum()
         })
@@ -308,36 +311,107 @@ pub fn grab_shares_mirrored(
     reach.fit(&samples.layout, &targets)
 }
 
-/// Each image's weight at x. Where only one image's disc reaches x, its falloff f. Where several
-/// overlap, together they move x by Σ f_k² / Σ f_k (each falloff weighted by itself: the one
-/// image's f where the discs coincide, at most the largest f, and smooth where the discs start
-/// to overlap), shared in proportion to the falloffs; so a point on a mirror plane moves once,
-/// as one brush moves it. (Dividing by the sum where that exceeds 1 put a kink in the field
-/// there, and a grab near a plane came out crumpled.)
-fn image_weights(
-    x: Point3,
-    centres: &[(Point3, Vector3)],
+/// The brush's field where mirror images of it overlap: each image's weight at a point x.
+///
+/// Where only one image's disc reaches x, its falloff f. Where two images' discs do, together they
+/// move x by T = U(f_j, f_k; g), with g = |c_j − c_k| / 2R (at most 1) saying how far apart the
+/// discs are and U(a, b; g) the larger root of z² − (a + b) z + (1 − g²) a b = 0:
+/// - where the discs only touch (g = 1), the sum a + b (the images act apart);
+/// - where they coincide (g = 0), the larger falloff (the images act as one brush);
+/// - in between at least the larger falloff and at most the sum, so the field never dips between
+///   the images; and smooth wherever a disc reaches, a falloff that fades smoothly to 0 at its rim
+///   fading out of T as smoothly (U(a, b) ≈ a + g² b for small b).
+///
+/// With several planes the images are combined a plane at a time: each image with its mirror
+/// image in the X plane, then those pairs with theirs in the Y plane, then Z. Images a caller left
+/// out (the editor leaves out those that fall on an earlier one, for a point on a plane) count as
+/// the one they fall on. T is shared among the images in proportion to their falloffs, and the
+/// whole field is divided by T at the first centre (the picked point): an image's disc that
+/// reaches the picked point raises T there above 1, and the picked point is to move by Δ exactly,
+/// as [`Symmetry::limit_grab`] has it, so that the edit's correction has nothing to add.
+///
+/// (What this replaces: Σ f² / Σ f, which dips between two discs, to 2(√2 − 1) of the larger
+/// falloff, so a grab 0.1–0.3 R off a plane came out with two crests and a spike at the picked
+/// point; before that, the falloffs divided by their sum where it passed 1, which put a kink in
+/// the field there.)
+struct ImageField<'a> {
+    centres: &'a [(Point3, Vector3)],
     radius: f64,
     falloff: Falloff,
-) -> impl Iterator<Item = (usize, f64)> + '_ {
-    let at = move |c: &Point3| falloff.at((x - c).norm() / radius);
-    let (mut sum, mut squares, mut reaching) = (0.0, 0.0, 0);
-    for (c, _) in centres {
-        let f = at(c);
-        sum += f;
-        squares += f * f;
-        reaching += usize::from(f > 0.0);
+    /// 1 / T at the first centre.
+    scale: f64,
+}
+
+impl<'a> ImageField<'a> {
+    fn new(centres: &'a [(Point3, Vector3)], radius: f64, falloff: Falloff) -> Self {
+        let mut field = ImageField {
+            centres,
+            radius,
+            falloff,
+            scale: 1.0,
+        };
+        if let Some(&(first, _)) = centres.first() {
+            let total = field.total(&field.falloffs(first));
+            if total > 0.0 {
+                field.scale = 1.0 / total;
+            }
+        }
+        field
     }
-    let scale = if reaching > 1 {
-        squares / (sum * sum)
-    } else {
-        1.0
-    };
-    centres
-        .iter()
-        .enumerate()
-        .map(move |(k, (c, _))| (k, at(c) * scale))
-        .filter(|&(_, w)| w > 0.0)
+
+    /// Each image's falloff at x.
+    fn falloffs(&self, x: Point3) -> Vec<f64> {
+        self.centres
+            .iter()
+            .map(|(c, _)| self.falloff.at((x - c).norm() / self.radius))
+            .collect()
+    }
+
+    /// U(a, b; g) for discs whose centres are `p` and `q`.
+    fn union(&self, (a, p): (f64, Point3), (b, q): (f64, Point3)) -> f64 {
+        let g = ((p - q).norm() / (2.0 * self.radius)).min(1.0);
+        0.5 * (a + b) + (0.5 * (a - b)).hypot(g * (a * b).sqrt())
+    }
+
+    /// T: how far the images together move a point with these falloffs. Each image has a slot
+    /// by the planes its signs flip (bit 0: X, 1: Y, 2: Z); the slots are merged a plane at a time.
+    fn total(&self, f: &[f64]) -> f64 {
+        let mut slots: [Option<(f64, Point3)>; 8] = [None; 8];
+        for (&(centre, signs), &f) in self.centres.iter().zip(f) {
+            let slot = (0..3)
+                .filter(|&a| signs[a] < 0.0)
+                .map(|a| 1 << a)
+                .sum::<usize>();
+            slots[slot] = Some(match slots[slot] {
+                Some(there) => (self.union(there, (f, centre)), there.1),
+                None => (f, centre),
+            });
+        }
+        for plane in [1, 2, 4] {
+            for slot in (0..8).filter(|s| s & plane == 0) {
+                slots[slot] = match (slots[slot], slots[slot | plane].take()) {
+                    (Some(a), Some(b)) => Some((self.union(a, b), a.1)),
+                    (a, b) => a.or(b),
+                };
+            }
+        }
+        slots[0].map_or(0.0, |(t, _)| t)
+    }
+
+    /// Each reaching image's weight at x.
+    fn weights(&self, x: Point3) -> impl Iterator<Item = (usize, f64)> + use<> {
+        let f = self.falloffs(x);
+        let sum: f64 = f.iter().sum();
+        let share = if sum > 0.0 {
+            self.total(&f) * self.scale / sum
+        } else {
+            0.0
+        };
+        f.into_iter()
+            .enumerate()
+            .map(move |(k, f)| (k, f * share))
+            .filter(|&(_, w)| w > 0.0)
+    }
 }
 
 /// S_u × S_v made a unit vector.
@@ -372,12 +446,9 @@ pub fn dab(
     let Some(reach) = Reach::new(samples, &only, radius)? else {
         return Ok(Vec::new());
     };
-    // Each image's falloff at a vertex, summed (capped at 1 where discs overlap).
-    let weight = |x: Point3| -> f64 {
-        image_weights(x, centres, radius, falloff)
-            .map(|(_, w)| w)
-            .sum()
-    };
+    // The images' weights at a vertex, summed (1 at the brush's centre; see `ImageField`).
+    let images = ImageField::new(centres, radius, falloff);
+    let weight = |x: Point3| -> f64 { images.weights(x).map(|(_, w)| w).sum() };
     let field: Box<dyn Fn(usize) -> Vector3> = match kind {
         BrushKind::Grab => return Err(EmbeddingError::NoDab(kind.name())),
         BrushKind::Smooth => {
@@ -402,7 +473,8 @@ pub fn dab(
             let planes = planes(samples, &reach, centres, radius, falloff);
             Box::new(move |r| {
                 let (x, here) = (samples.positions[r], unit_normal(samples.tangents[r]));
-                image_weights(x, centres, radius, falloff)
+                images
+                    .weights(x)
                     .map(|(k, w)| {
                         let (c, n) = planes[k];
                         let facing = here.dot(&n).max(0.0);
@@ -977,6 +1049,135 @@ mod tests {
                     prop_assert!(after * x > 0.0, "crossed the plane");
                     prop_assert!(after.abs() >= 0.5 * x.abs().min(radius) - 1e-12);
                 }
+            }
+        }
+
+        /// The images' field (`ImageField`), for a point and its mirror images under 1–3 planes
+        /// (those that fall on an earlier one left out, as the editor does), at random points:
+        /// together the images move a point at least as far as the largest falloff and at most as
+        /// far as their sum (so it never dips between them), by exactly the one falloff where only
+        /// one disc reaches and where all the discs coincide; the field is as symmetric as the
+        /// images (the same at a point's mirror images, each image's weight carried to its
+        /// own); and the picked point moves by exactly Δ.
+        #[test]
+        fn the_images_field_lies_between_the_largest_falloff_and_the_sum(
+            p in prop::array::uniform3(-1.0f64..1.0),
+            on_plane in prop::array::uniform3(any::<bool>()),
+            planes in 1u8..8,
+            radius in 0.05f64..3.0,
+            falloff in prop::sample::select(vec![Falloff::Smooth, Falloff::Dome, Falloff::Sharp, Falloff::Constant]),
+            xs in prop::collection::vec(prop::array::uniform3(-1.5f64..1.5), 16),
+        ) {
+            let symmetry = Symmetry { x: planes & 1 != 0, y: planes & 2 != 0, z: planes & 4 != 0 };
+            let p = Point3::from(Vector3::from(p).zip_map(&Vector3::from(on_plane.map(|o| !o).map(f64::from)), |a, b| a * b));
+            let centres = mirror_centres(symmetry, p);
+            let field = ImageField::new(&centres, radius, falloff);
+            let first: f64 = field.weights(p).map(|(_, w)| w).sum();
+            prop_assert!((first - 1.0).abs() < 1e-12, "the picked point moves by {first} of Δ");
+            for x in xs {
+                let x = Point3::from(Vector3::from(x));
+                let f = field.falloffs(x);
+                let total = field.total(&f);
+                let (largest, sum) = (f.iter().copied().fold(0.0, f64::max), f.iter().sum::<f64>());
+                prop_assert!(total >= largest * (1.0 - 1e-12) && total <= sum * (1.0 + 1e-12),
+                    "{total} outside [{largest}, {sum}]");
+                if f.iter().filter(|&&f| f > 0.0).count() <= 1 || centres.len() == 1 {
+                    prop_assert!((total - largest).abs() <= 1e-12 * largest);
+                }
+                let weights: Vec<(usize, f64)> = field.weights(x).collect();
+                for signs in symmetry.images() {
+                    let mirrored = Point3::from(x.coords.component_mul(&signs));
+                    let there: Vec<(usize, f64)> = field.weights(mirrored).collect();
+                    let total_there = field.total(&field.falloffs(mirrored));
+                    prop_assert!((total_there - total).abs() <= 1e-9 * total.max(1e-300),
+                        "{total} at x, {total_there} at its image {signs:?}");
+                    for &(k, w) in &weights {
+                        // The image that x's k-th image's centre becomes under the mirror.
+                        let carried = Point3::from(centres[k].0.coords.component_mul(&signs));
+                        let j = centres.iter().position(|c| (c.0 - carried).norm() < 1e-9).expect("a group");
+                        let w_there = there.iter().find(|t| t.0 == j).map_or(0.0, |t| t.1);
+                        prop_assert!((w_there - w).abs() <= 1e-9 * w.max(1.0), "image {k}: {w} against {w_there}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The centres a brush at `p` acts at under `symmetry`: `p`, then each mirror image that does
+    /// not fall on an earlier one, with its signs (as the editor's `mirror_images`).
+    fn mirror_centres(symmetry: Symmetry, p: Point3) -> Vec<(Point3, Vector3)> {
+        let mut centres: Vec<(Point3, Vector3)> = Vec::new();
+        for signs in symmetry.images() {
+            let image = Point3::from(p.coords.component_mul(&signs));
+            if centres.iter().all(|c| (c.0 - image).norm() > 1e-12) {
+                centres.push((image, signs));
+            }
+        }
+        centres
+    }
+
+    /// Two images of a smooth falloff at 0.03–1.9 R apart: where the discs coincide the field is
+    /// the one falloff, where they only touch the sum; it has no kink (along the line through the
+    /// centres and across it, halving the step leaves the largest second difference within 5%,
+    /// where a kink would double it), and between the centres it stays within 5% of the picked
+    /// point's 1 up to 0.3 R apart (one bump, not two crests).
+    #[test]
+    fn two_images_make_one_smooth_bump() {
+        let symmetry = Symmetry {
+            x: true,
+            y: false,
+            z: false,
+        };
+        let coincide = mirror_centres(symmetry, Point3::new(0.0, 0.2, 0.0));
+        assert_eq!(coincide.len(), 1);
+        let both = [coincide[0], (coincide[0].0, Vector3::new(-1.0, 1.0, 1.0))];
+        let field = ImageField::new(&both, 1.0, Falloff::Smooth);
+        for s in [0.1, 0.5, 0.9] {
+            let x = Point3::new(s, 0.2, 0.0);
+            let one = Falloff::Smooth.at(s);
+            assert!((field.total(&field.falloffs(x)) - one).abs() < 1e-12);
+        }
+        let touch = mirror_centres(symmetry, Point3::new(1.0, 0.0, 0.0));
+        let field = ImageField::new(&touch, 1.0, Falloff::Smooth);
+        let f = [0.3, 0.4];
+        assert!((field.total(&f) - 0.7).abs() < 1e-12);
+
+        for apart in [0.03, 0.1, 0.2, 0.4, 0.6, 1.0, 1.5, 1.9] {
+            let centres = mirror_centres(symmetry, Point3::new(apart / 2.0, 0.0, 0.0));
+            let field = ImageField::new(&centres, 1.0, Falloff::Smooth);
+            let value = |x: f64, y: f64| -> f64 {
+                field.weights(Point3::new(x, y, 0.0)).map(|(_, w)| w).sum()
+            };
+            for (along, label) in [(true, "along"), (false, "across")] {
+                let largest_second_difference = |h: f64| {
+                    (1..(2.0 / h) as usize)
+                        .map(|i| {
+                            let t = -1.0 + i as f64 * h;
+                            let at = |t: f64| if along { value(t, 0.0) } else { value(0.0, t) };
+                            ((at(t + h) - 2.0 * at(t) + at(t - h)) / (h * h)).abs()
+                        })
+                        .fold(0.0, f64::max)
+                };
+                let (coarse, fine) = (
+                    largest_second_difference(0.01),
+                    largest_second_difference(0.005),
+                );
+                assert!(
+                    fine < 1.05 * coarse,
+                    "{apart} R apart, {label}: {coarse} then {fine}"
+                );
+            }
+            if apart <= 0.6 {
+                let lowest = (0..=100)
+                    .map(|i| value(-apart / 2.0 + apart * i as f64 / 100.0, 0.0))
+                    .fold(f64::INFINITY, f64::min);
+                let highest = (0..=100)
+                    .map(|i| value(-apart / 2.0 + apart * i as f64 / 100.0, 0.0))
+                    .fold(0.0, f64::max);
+                assert!(
+                    lowest > 0.95 && highest < 1.05,
+                    "{apart} R apart: {lowest}..{highest} between the centres"
+                );
             }
         }
     }
