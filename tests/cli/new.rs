@@ -207,17 +207,19 @@ fn the_default_genus_3_plate_has_fair_rims() {
 }
 
 /// High genus, where the charts barely overlap: with disk charts of 128 and no agreement rows
-/// `new` refused genus 28 (its largest |κ| 3.31× the input's, a ridge along a chart's fringe).
-/// With disk charts of 256 and the agreement rows it reads 1.81× and writes the model (about 40 s
-/// and 2.9 GB here); 1.58× with its rims sampled finer (`holed::RIM_REFINEMENT`).
+/// `new` refused genus 28 (its largest |κ| 3.31× the input's, a ridge along a chart's fringe);
+/// with disk charts of 256 and the agreement rows genus 28 read 1.81× and was written. Genus 24,
+/// one of issue 12's genera, is held to its 1.5×: 1.73× with the rims sampled finer
+/// (`holed::RIM_REFINEMENT`) at λ = 2e-3, 1.42× at the plates' 1e-2 (`fit::PLATE_SMOOTHNESS_UP_TO`;
+/// about 35 s and 2.7 GB here in release).
 #[test]
-fn genus_28_passes_its_checks_and_is_written() {
+fn genus_24_passes_its_checks_within_one_and_a_half_times_the_inputs_curvature() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("twenty-eight.json");
+    let path = dir.path().join("twenty-four.json");
     let report = ntori_json(&[
         "new".as_ref(),
         "--genus".as_ref(),
-        "28".as_ref(),
+        "24".as_ref(),
         "--json".as_ref(),
         "-q".as_ref(),
         "-o".as_ref(),
@@ -233,7 +235,7 @@ fn genus_28_passes_its_checks_and_is_written() {
     assert_eq!(report["settings"]["disk_grid"].as_u64(), Some(256));
     let shape = &report["shape"];
     let ratio = shape["curvature_ratio"].as_f64().unwrap();
-    assert!(ratio < 2.5, "{shape}");
+    assert!(ratio < 1.5, "{shape}");
     assert!(
         shape["patch_disagreement"].as_f64().unwrap() < 1e-4,
         "{shape}"

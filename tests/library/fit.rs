@@ -501,12 +501,12 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
         default_smoothness(FINE_GRID)
     );
     // What `new` fits with where nothing is chosen: the grid, its smoothness, the other defaults.
-    // The plates' stronger weight: genus 2 to 16 on grids finer than 32, not the sphere or the
-    // torus on any grid, not genus 17 and up, not a coarse grid.
+    // The plates' stronger weight: genus 2 to 30 on grids finer than 32, not the sphere or the
+    // torus on any grid, not genus 31 and up, not a coarse grid.
     use embedding::fit::{PLATE_SMOOTHNESS, default_plate_smoothness};
     for genus in 0..=64 {
         for grid in [16, 32, 40, FINE_GRID, 64] {
-            let expected = if (2..=16).contains(&genus) && grid > 32 {
+            let expected = if (2..=30).contains(&genus) && grid > 32 {
                 PLATE_SMOOTHNESS
             } else {
                 default_smoothness(grid)
@@ -531,8 +531,8 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
             (d.degree, d.continuity)
         });
         assert_eq!(fit, FitSettings::for_plate(genus, spline), "genus {genus}");
-        // The plates of genus 2 to 16 take the stronger weight on their fine grids.
-        let expected = if (2..=16).contains(&genus) {
+        // The plates of genus 2 to 30 take the stronger weight on their fine grids.
+        let expected = if (2..=30).contains(&genus) {
             embedding::fit::PLATE_SMOOTHNESS
         } else {
             FitSettings::for_grid(spline.grid).smoothness
