@@ -302,7 +302,18 @@ pub const MAX_FIT_TRIANGLES: usize = 400_000;
 /// size (genus 2: 0.65 s for 10 948 triangles, 6.8 s for 42 732, 100 s for 169 556 measured
 /// before the symbolic analysis was reused, which saved about a fifth), so a genus
 /// whose default mesh would be finer gets a coarser one; `--resolution` can go up to the cap.
-pub const DEFAULT_FIT_TRIANGLES: usize = 200_000;
+///
+/// 300 000, not 200 000 as it was: from genus 25 the budget sets the plates' resolution, and at
+/// high genus the largest |κ| follows the input's sampling of the rims (the fit goes through the
+/// input's vertices). With 200 000 → 300 000 triangles (and λ = 1e-2, [`PLATE_SMOOTHNESS_UP_TO`]),
+/// `ntori new`'s largest |κ| against the input's: genus 25 1.53× → 1.28×, 26 1.57× → 1.30×, 27
+/// 1.51× → 1.38×, 28 1.53× → 1.43×, 29 1.66× → 1.40×, 30 1.74× → 1.53×, 31 2.25× → 1.96×, 32
+/// 2.33× → 1.88×, 33 2.94× → 2.57×, 34 2.68× → 1.94×, 35 2.82× → 2.17×, 36 3.10× → 2.22×, 37
+/// 2.95× → 2.35×, 40 3.7× → 2.84× (written now), the flat faces' |H| × half-thickness at
+/// most 0.0098 from 25 to 40 (0.0129–0.0168 before) and the normals at most 0.28° at the 90th
+/// percentile (0.34–0.44°). It costs time and memory: `ntori new` at genus 32 39 s and 2.5 GB →
+/// 57 s and 3.5 GB, genus 25 to 31 34–41 s → 46–56 s, 34 to 40 50–60 s → 67–74 s.
+pub const DEFAULT_FIT_TRIANGLES: usize = 300_000;
 
 /// A stage of [`initial_model_with_progress`], for progress displays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -563,9 +574,12 @@ pub fn default_plate_smoothness(genus: u32, grid: usize) -> f64 {
 /// (The flat faces at 2e-3 were not recorded one by one from genus 22 to 30 but lay between 0.0125
 /// and 0.0191.)
 /// 3e-2 was no better (24 1.44×, 25 1.50×, 26 1.65×, 29 1.63×, 30 1.77×). From genus 31, whose
-/// rims are sampled as the faces are, 1e-2 did not help (31 2.21× → 2.25×, 32 2.30× → 2.33×) and
-/// genus 36 failed the curvature check (3.10×), so they keep 2e-3.
-pub const PLATE_SMOOTHNESS_UP_TO: u32 = 30;
+/// rims are sampled as the faces are, 1e-2 did not help on meshes of 200 000 triangles (31 2.21×
+/// → 2.25×, 32 2.30× → 2.33×, 33 to 37 2.68–3.10×, genus 36 failing the curvature check), but on
+/// the finer meshes of [`DEFAULT_FIT_TRIANGLES`] it did: genus 32 read 2.18× at 2e-3 and 1.88× at
+/// 1e-2 (280 068 triangles), and 1e-2 gave 1.94–2.57× from 31 to 37 and 2.84× at 40, which was
+/// refused before (3.7×). Genus 48 still fails (4.05×); above 40 the weight was not measured.
+pub const PLATE_SMOOTHNESS_UP_TO: u32 = 40;
 
 /// The plates' smoothness weight on grids finer than 32 up to genus [`PLATE_SMOOTHNESS_UP_TO`]
 /// ([`default_plate_smoothness`]), five times [`default_smoothness`]'s 2e-3 there. At 2e-3 genus 2's eased rims round the holes carried
@@ -747,10 +761,10 @@ pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
 
 /// The resolution `ntori new` and the editor use for `genus`: [`TORUS_RESOLUTION`] for the torus,
 /// [`FINE_RESOLUTION`] for genus 3 to 16, [`DEFAULT_RESOLUTION`] for the others, or
-/// where that mesh has more than [`DEFAULT_FIT_TRIANGLES`] (genus 24 and 32, not 16), nearly the
-/// finest within it (the plates' triangles grow as the resolution's square): genus 24 gets 27, 32
-/// gets 21. Where even resolution 8 has more, 8 (genus 64: 223 516 triangles, within
-/// [`MAX_FIT_TRIANGLES`]).
+/// where that mesh has more than [`DEFAULT_FIT_TRIANGLES`] (from genus 25, not 24), nearly the
+/// finest within it (the plates' triangles grow as the resolution's square): genus 28 gets 29, 32
+/// gets 26, 48 gets 16, 64 gets 11. Where even resolution 8 has more, 8 (no genus up to 64 does:
+/// genus 64 has 223 516 triangles at 8).
 ///
 /// Why 40 from genus 3 (to 9 at first; 10 to 16 below): there the fit's largest curvature sits on a hole's rim between the
 /// input's vertices (0.1 apart on a rim of radius 0.25 at 32), and its size follows the rim's
@@ -789,7 +803,7 @@ pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
 /// 1.32×, normals 0.30° → 0.22° at the 90th percentile, flat faces' |H|·T 0.0182 → 0.0149, in
 /// 24.2 s against 17.8 s and 1.5 GB against 1.3 GB (172 100 triangles, 189 516 with the rims'
 /// rings, within [`DEFAULT_FIT_TRIANGLES`]). Genus 20 at 32 read 1.79×, and at 40 1.63× (252 692 triangles,
-/// past the budget), so from 17 the plates keep 32, or less where the budget says. A finer mesh
+/// past the budget of then, 200 000), so from 17 the plates keep 32, or less where the budget says. A finer mesh
 /// only near the rims (the flat faces at 1.5 or 2 times the rims' spacing) was tried: it kept the curvature gain at genus 5 (1.33×) at the time of
 /// resolution 32, but the flat faces rippled (|H|·T 0.044–0.061), and genus 32 with rims at 32
 /// read 3.66× against 3.37× (its peak is not on a rim's samples).
