@@ -311,8 +311,10 @@ pub const MAX_FIT_TRIANGLES: usize = 400_000;
 /// 2.33× → 1.88×, 33 2.94× → 2.57×, 34 2.68× → 1.94×, 35 2.82× → 2.17×, 36 3.10× → 2.22×, 37
 /// 2.95× → 2.35×, 40 3.7× → 2.84× (written now), the flat faces' |H| × half-thickness at
 /// most 0.0098 from 25 to 40 (0.0129–0.0168 before) and the normals at most 0.28° at the 90th
-/// percentile (0.34–0.44°). It costs time and memory: `ntori new` at genus 32 39 s and 2.5 GB →
-/// 57 s and 3.5 GB, genus 25 to 31 34–41 s → 46–56 s, 34 to 40 50–60 s → 67–74 s.
+/// percentile (0.34–0.44°). With the rims' rings from genus 31 to 40 as well
+/// ([`crate::holed::RIM_REFINEMENT_UP_TO`]) genus 32 reads 1.70× (293 208 triangles). It costs
+/// time and memory: `ntori new` at genus 32 39 s → 57 s (3.6 GB peak; 2.6–3.2 GB was recorded for
+/// genus 17 to 33 before), genus 25 to 31 34–41 s → 46–56 s, 34 to 40 50–60 s → 67–74 s.
 pub const DEFAULT_FIT_TRIANGLES: usize = 300_000;
 
 /// A stage of [`initial_model_with_progress`], for progress displays.
