@@ -5,7 +5,7 @@
 //! into triangles, which the fit then takes like any other mesh, with the limit normals as the
 //! intended shape's.
 
-use embedding::fit::{DEFAULT_FIT_TRIANGLES, MAX_FIT_TRIANGLES};
+use embedding::fit::MAX_FIT_TRIANGLES;
 use embedding::{Point3, Vector3};
 
 use super::{ImportError, ImportedMesh, Polygons, ValidMesh};
@@ -123,8 +123,13 @@ fn triangles_at(corners: usize, level: u32) -> usize {
     corners.saturating_mul(per_corner).saturating_mul(2)
 }
 
+/// The most triangles a cage's default level makes, for time: `new`'s plates' budget as it was
+/// (`embedding::fit::DEFAULT_FIT_TRIANGLES`, now 300 000 for the high-genus plates, whose
+/// curvature follows their rims' sampling; a user's cage was not measured at more).
+const CAGE_FIT_TRIANGLES: usize = 200_000;
+
 /// The fewest levels from 2 that make [`CAGE_TRIANGLES`], or, for a cage so fine that this is
-/// more than a default fit takes ([`DEFAULT_FIT_TRIANGLES`], for time), the most within it (down
+/// more than a default fit takes ([`CAGE_FIT_TRIANGLES`], for time), the most within it (down
 /// to 1; `--cage-level` may go up to [`MAX_FIT_TRIANGLES`]).
 fn default_level(corners: usize) -> u32 {
     let wanted = (2..MAX_CAGE_LEVEL)
@@ -132,7 +137,7 @@ fn default_level(corners: usize) -> u32 {
         .unwrap_or(MAX_CAGE_LEVEL);
     (1..=wanted)
         .rev()
-        .find(|&l| triangles_at(corners, l) <= DEFAULT_FIT_TRIANGLES)
+        .find(|&l| triangles_at(corners, l) <= CAGE_FIT_TRIANGLES)
         .unwrap_or(1)
 }
 
