@@ -82,7 +82,7 @@ struct Circle {
 impl Circle {
     /// Distance from `q` to the circle, positive on the region's side.
     fn depth(&self, q: P2) -> f64 {
-        let r = (q[0] - self.centre[0]).hypot(q[1] - self.centre[1]);
+        let r = dist(q, self.centre);
         if self.hole {
             r - self.radius
         } else {
@@ -160,7 +160,7 @@ pub const RIM_REFINEMENT_UP_TO: u32 = 40;
 /// from the pair in a canonical order, so the same segment requested backwards gives the same bits —
 /// segments shared by two loops then meet in shared vertices.
 fn segment(a: P2, b: P2, h: f64) -> Vec<P2> {
-    let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+    let len = dist(a, b);
     let m = (len / h).ceil().max(1.0) as usize;
     let (p, q, flip) = if a <= b { (a, b, false) } else { (b, a, true) };
     let mut pts: Vec<P2> = (0..=m)
