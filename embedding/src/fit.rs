@@ -32,7 +32,7 @@ use num_complex::Complex64;
 
 use crate::harmonic::Convergence;
 use crate::holed::HoledMesh;
-use crate::least_squares::LeastSquares;
+use crate::least_squares::{Analysis, LeastSquares, NormalAnalysis};
 use crate::spline_surface::Surface;
 use crate::surface::{Layout, Point3, SplineSettings};
 use crate::{EmbeddingError, floater};
@@ -1374,17 +1374,23 @@ impl Lifts {
     ///
     /// A first round (nothing kept) starts from Floater's map, far from the fixed point:
     /// [`WARMUP_SWEEPS`] sweeps smooth it first. A later round starts at the round before's fixed
-    /// point, its weights changed a little: there the kept Jacobian's chord steps take it most of
-    /// the way and sweeps only slow it down. Measured on `ntori new`'s second round: genus 10
-    /// 1.24 s (300 sweeps, 2 factorizations) → 0.57 s (none, 1), genus 32 12.2 s → 7.0 s; the map
-    /// the same to the tolerance.
+    /// point, its weights changed a little: there the kept Jacobian, as GMRES's preconditioner,
+    /// takes it most of the way and sweeps only slow it down. Measured on `ntori new`'s second
+    /// round (with chord steps then): genus 10 1.24 s (300 sweeps, 2 factorizations) → 0.57 s
+    /// (none, 1), genus 32 12.2 s → 7.0 s; the map the same to the tolerance.
     pub(crate) fn settle(
         &mut self,
         hyperbolic: bool,
         kept: &mut Option<crate::harmonic::KeptJacobian>,
     ) -> Result<Convergence, EmbeddingError> {
         let swept = if kept.is_none() {
-            self.relax(hyperbolic, WARMUP_SWEEPS, RELAX_TOLERANCE)
+            let pattern = crate::harmonic::pattern(self, hyperbolic);
+            let (swept, analysis) = rayon::join(
+                || self.relax(hyperbolic, WARMUP_SWEEPS, RELAX_TOLERANCE),
+                || crate::harmonic::KeptJacobian::analyse(pattern),
+            );
+            *kept = Some(analysis?);
+            swept
         } else {
             0
         };
@@ -1726,23 +1732,26 @@ pub fn fit(
             settings.smoothness
         )));
     }
-    let start = std::time::Instant::now();
-    let mut data = DataRows::new(layout, points, targets, weights, settings.patch_weight);
-    if settings.agreement > 0.0 {
-        data.append_agreement(layout, settings.agreement);
+    let data = DataRows::with_agreement(layout, points, targets, weights, settings);
+    if !settings.surface_smoothness {
+        let alongside = || data.analysis(layout);
+        let analysis = Analysis::Alongside(&alongside);
+        return data.solve(
+            layout,
+            &smoothness_rows(layout),
+            settings.smoothness,
+            analysis,
+        );
     }
-    tracing::debug!(
-        points = points.len(),
-        controls = layout.control_count(),
-        seconds = start.elapsed().as_secs_f64(),
-        "the fit's data rows built"
+    // The arc-length rows need a first fit; the normal equations' analysis needs only which
+    // control points the rows reach, which the data rows and the rows' stencils tell: both at once.
+    let (smooth, analysis) = rayon::join(
+        || arc_length_smoothness(layout, &data, points, targets, weights, settings),
+        || data.analysis(layout),
     );
-    let smooth = if settings.surface_smoothness {
-        arc_length_smoothness(layout, &data, points, targets, weights, settings)?
-    } else {
-        smoothness_rows(layout)
-    };
-    data.solve(layout, &smooth, settings.smoothness)
+    // Where the analysis could not be made, the solve makes its own (and reports what fails).
+    let analysis = analysis.as_ref().map_or(Analysis::Here, Analysis::Ahead);
+    data.solve(layout, &smooth?, settings.smoothness, analysis)
 }
 
 /// The smoothness rows in the surface's arc length ([`FitSettings::surface_smoothness`]), with the
@@ -1761,7 +1770,12 @@ fn arc_length_smoothness(
     let fine = layout.settings();
     let coarsening = settings.metric_coarsening.max(1);
     if coarsening == 1 {
-        let control = data.solve(layout, &smoothness_rows(layout), settings.smoothness)?;
+        let control = data.solve(
+            layout,
+            &smoothness_rows(layout),
+            settings.smoothness,
+            Analysis::Here,
+        )?;
         let metrics = crate::bending::grid_metrics(layout, &control);
         return Ok(crate::bending::arc_length_rows(layout, &metrics));
     }
@@ -1780,7 +1794,14 @@ fn arc_length_smoothness(
         smoothness: settings.smoothness * (step(fine.grid) / step(coarse.grid)).powi(4),
         ..settings
     };
-    let control = fit(&coarse_layout, points, targets, weights, plain)?;
+    // Here the other core is making the fine system's analysis (see `fit`): this one's is made
+    // from its own AᵀA.
+    let control = DataRows::with_agreement(&coarse_layout, points, targets, weights, plain).solve(
+        &coarse_layout,
+        &smoothness_rows(&coarse_layout),
+        plain.smoothness,
+        Analysis::Here,
+    )?;
     Ok(crate::bending::arc_length_rows(
         layout,
         &crate::bending::patch_metrics(layout, &coarse_layout, &control),
@@ -1796,6 +1817,28 @@ struct DataRows {
 }
 
 impl DataRows {
+    /// The rows of [`DataRows::new`], and the agreement rows where `settings` asks for them.
+    fn with_agreement(
+        layout: &Layout,
+        points: &[ChartPoint],
+        targets: &[Point3],
+        weights: &[f64],
+        settings: FitSettings,
+    ) -> DataRows {
+        let start = std::time::Instant::now();
+        let mut data = DataRows::new(layout, points, targets, weights, settings.patch_weight);
+        if settings.agreement > 0.0 {
+            data.append_agreement(layout, settings.agreement);
+        }
+        tracing::debug!(
+            points = points.len(),
+            controls = layout.control_count(),
+            seconds = start.elapsed().as_secs_f64(),
+            "the fit's data rows built"
+        );
+        data
+    }
+
     /// The rows fitting each point of `points` to its target (weighted by `weights`, relative to
     /// their mean) and, at `patch_weight`, each chart's own patch to the same target where the
     /// chart's blend is positive (weighted by it).
@@ -1887,16 +1930,44 @@ impl DataRows {
     }
 
     /// The control points fitting these rows with the smoothness rows `smooth` at weight λ
-    /// (`smoothness`; [`DataRows::with_smoothness`]).
+    /// (`smoothness`; [`DataRows::with_smoothness`]), with the normal equations' analysis made
+    /// ahead where there is one ([`DataRows::analysis`]).
     fn solve(
         &self,
         layout: &Layout,
         smooth: &[Vec<(usize, f64)>],
         smoothness: f64,
+        analysis: Analysis<'_>,
     ) -> Result<Vec<Point3>, EmbeddingError> {
         let (rows, triplets, rhs) = self.with_smoothness(smooth, smoothness);
-        let x = LeastSquares::new(rows, layout.control_count(), &triplets)?.solve(&rhs);
+        let x = LeastSquares::new(rows, layout.control_count(), &triplets, analysis)?.solve(&rhs);
         control_points(&x, smoothness)
+    }
+
+    /// The normal equations' analysis for these rows with any smoothness rows whose each row
+    /// stays within the 3 × 3 block of one grid point whose neighbours are all on the grid: the
+    /// plain rows (second differences, and the twist's 2 × 2) and the arc-length rows (the
+    /// Hessian's stencils at interior points) both do.
+    fn analysis(&self, layout: &Layout) -> Result<NormalAnalysis, EmbeddingError> {
+        let data_rows = self.rhs.nrows();
+        let mut blocks = Vec::new();
+        for chart in layout.atlas().charts() {
+            let g = layout.grid(chart.id());
+            for j in 1..g.saturating_sub(1) {
+                for i in 1..g - 1 {
+                    let row = data_rows + blocks.len() / 9;
+                    for (di, dj) in (0..3).flat_map(|a| (0..3).map(move |b| (a, b))) {
+                        blocks.push((
+                            row,
+                            layout.control_index(chart.id(), i + di - 1, j + dj - 1),
+                        ));
+                    }
+                }
+            }
+        }
+        let rows = data_rows + blocks.len() / 9;
+        let entries = self.triplets.iter().map(|t| (t.row, t.col));
+        NormalAnalysis::new(rows, layout.control_count(), entries.chain(blocks))
     }
 
     /// The whole system with the smoothness rows `smooth` at weight λ (`smoothness`) appended:
@@ -2035,5 +2106,47 @@ pub(crate) fn smoothness_rows_at(
             (at(i, j + 1), -s),
             (at(i + 1, j + 1), s),
         ]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The analysis the fit makes ahead from the data rows and the smoothness stencils holds
+    /// the whole system's AᵀA, with the plain rows and with the arc-length rows, on the plates
+    /// and grids `new` uses for genus 2, 5, 8 and 12 (else the fit would analyse it again
+    /// and lose the time the analysis saves).
+    #[test]
+    fn the_analysis_made_ahead_holds_the_fit_s_systems() {
+        for genus in [2, 5, 8, 12] {
+            let (spline, settings) = default_settings(genus);
+            let atlas = Arc::new(Atlas::new(genus).unwrap());
+            let layout = Layout::new(&atlas, spline).unwrap();
+            let mesh = HoledMesh::new(genus, 8).unwrap();
+            let parameterization = parameterize(&atlas, &mesh, 1).unwrap();
+            let weights = vertex_areas(&mesh.positions, &mesh.triangles);
+            let (points, targets) = (&parameterization.points, &mesh.positions);
+            let data = DataRows::with_agreement(&layout, points, targets, &weights, settings);
+            let analysis = data.analysis(&layout).unwrap();
+            let arc = FitSettings {
+                surface_smoothness: true,
+                ..settings
+            };
+            let arc_rows =
+                arc_length_smoothness(&layout, &data, points, targets, &weights, arc).unwrap();
+            for (name, smooth) in [
+                ("plain", smoothness_rows(&layout)),
+                ("arc length", arc_rows),
+            ] {
+                let (rows, triplets, _) = data.with_smoothness(&smooth, settings.smoothness);
+                let formed =
+                    crate::least_squares::form(rows, layout.control_count(), &triplets).unwrap();
+                assert!(
+                    analysis.spread(&formed.gram).is_some(),
+                    "genus {genus}, {name} rows: AᵀA reaches outside the analysis"
+                );
+            }
+        }
     }
 }

@@ -3,8 +3,8 @@
 
 use faer::Mat;
 use faer::prelude::*;
-use faer::sparse::linalg::solvers::Llt;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 
 use crate::EmbeddingError;
 
@@ -67,71 +67,270 @@ fn transpose_of_rows(
     Some(SparseColMat::new(symbolic, values))
 }
 
-impl LeastSquares {
-    /// Factors AᵀA (A `rows` × `cols`, from `triplets`). Where no row reaches some column, or the
-    /// rows leave some combination undetermined, AᵀA is singular and its Cholesky factorization
-    /// fails; then AᵀA + ε² I is factored instead, which picks the smallest such combination and
-    /// moves a determined solution by about ε² of its size.
+/// The normal equations' symbolic half, made ahead of the system from a pattern that holds its
+/// own: AᵀA's pattern (with every diagonal entry) and its Cholesky analysis (AMD's ordering, the
+/// elimination tree, the supernodes). It depends on which unknowns the rows reach, not on their
+/// values, so the fit makes it on another thread while it works the rows' values out (the
+/// arc-length rows need a first, coarse fit): at genus 10 AMD alone took about half a second.
+pub(crate) struct NormalAnalysis {
+    gram: SymbolicSparseColMat<usize>,
+    cholesky: SymbolicLlt<usize>,
+}
+
+impl NormalAnalysis {
+    /// From the rows' patterns: `entries` holds (row, unknown) pairs in row order, `rows` rows
+    /// over `cols` unknowns. A system whose rows reach no more than these is factored with it.
     pub(crate) fn new(
         rows: usize,
         cols: usize,
-        triplets: &[Triplet<usize, usize, f64>],
-    ) -> Result<LeastSquares, EmbeddingError> {
+        entries: impl Iterator<Item = (usize, usize)>,
+    ) -> Result<NormalAnalysis, EmbeddingError> {
         let start = std::time::Instant::now();
-        // Aᵀ straight from the rows where they come in order (as the fit writes them): no sort of
-        // the triplets, which took a third of forming AᵀA.
-        let at = match transpose_of_rows(rows, cols, triplets) {
-            Some(at) => at,
-            None => SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, triplets)
-                .map_err(|e| failed(rows, cols, e))?
-                .as_ref()
-                .transpose()
-                .to_col_major()
-                .map_err(|e| failed(rows, cols, e))?,
-        };
-        let built = start.elapsed().as_secs_f64();
+        // Aᵀ's pattern with a unit row per unknown appended (AᵀA's diagonal, which a ridge needs
+        // even where no row reaches the unknown).
+        let mut col_ptr = Vec::with_capacity(rows + cols + 1);
+        let mut row_idx = Vec::new();
+        col_ptr.push(0);
+        let mut row = Vec::new();
+        let mut entries = entries.peekable();
+        for r in 0..rows {
+            row.clear();
+            while let Some(&(_, c)) = entries.peek().filter(|e| e.0 == r) {
+                row.push(c);
+                entries.next();
+            }
+            if row.iter().any(|&c| c >= cols) {
+                return Err(failed(rows, cols, "an unknown out of range"));
+            }
+            row.sort_unstable();
+            row.dedup();
+            row_idx.extend_from_slice(&row);
+            col_ptr.push(row_idx.len());
+        }
+        if entries.next().is_some() {
+            return Err(failed(rows, cols, "rows out of order or out of range"));
+        }
+        for c in 0..cols {
+            row_idx.push(c);
+            col_ptr.push(row_idx.len());
+        }
+        let ones = vec![1.0; row_idx.len()];
+        let at = SparseColMat::new(
+            SymbolicSparseColMat::new_checked(cols, rows + cols, col_ptr, None, row_idx),
+            ones,
+        );
         let a = at
             .as_ref()
             .transpose()
             .to_col_major()
             .map_err(|e| failed(rows, cols, e))?;
-        let transposed = start.elapsed().as_secs_f64();
-        let gram = faer::sparse::linalg::matmul::sparse_sparse_matmul(
-            at.as_ref(),
-            a.as_ref(),
-            1.0,
-            faer::Par::Seq,
+        let (gram, _) = faer::sparse::linalg::matmul::sparse_sparse_matmul_symbolic(
+            at.symbolic(),
+            a.symbolic(),
         )
         .map_err(|e| failed(rows, cols, e))?;
         let formed = start.elapsed().as_secs_f64();
-        let (factor, ridge) = match gram.sp_cholesky(faer::Side::Lower) {
-            Ok(factor) => (factor, 0.0),
-            Err(_) => {
-                let ridge = EPSILON * EPSILON;
-                let diagonal: Vec<_> = (0..cols).map(|c| Triplet::new(c, c, ridge)).collect();
-                let shift =
-                    SparseColMat::<usize, f64>::try_new_from_triplets(cols, cols, &diagonal)
-                        .map_err(|e| failed(rows, cols, e))?;
-                let factor = (gram.as_ref() + shift.as_ref())
-                    .sp_cholesky(faer::Side::Lower)
-                    .map_err(|e| failed(rows, cols, e))?;
-                (factor, ridge)
+        let cholesky = SymbolicLlt::try_new(gram.as_ref(), faer::Side::Lower)
+            .map_err(|e| failed(rows, cols, e))?;
+        tracing::debug!(
+            rows,
+            cols,
+            pattern_seconds = formed,
+            analysis_seconds = start.elapsed().as_secs_f64() - formed,
+            "the normal equations analysed ahead"
+        );
+        Ok(NormalAnalysis { gram, cholesky })
+    }
+
+    /// `gram`'s values on this analysis's pattern (zeros where it has none), or `None` where
+    /// `gram` has an entry outside it.
+    pub(crate) fn spread(
+        &self,
+        gram: &SparseColMat<usize, f64>,
+    ) -> Option<SparseColMat<usize, f64>> {
+        let pattern = self.gram.as_ref();
+        if pattern.nrows() != gram.nrows() || pattern.ncols() != gram.ncols() {
+            return None;
+        }
+        let mut values = vec![0.0; pattern.row_idx().len()];
+        for c in 0..gram.ncols() {
+            let range = pattern.col_range(c);
+            let (rows, slots) = (&pattern.row_idx()[range.clone()], &mut values[range]);
+            let mut k = 0;
+            for (&r, &v) in gram
+                .as_ref()
+                .row_idx_of_col_raw(c)
+                .iter()
+                .zip(gram.val_of_col(c))
+            {
+                // Both columns are sorted: a merge.
+                while k < rows.len() && rows[k] < r {
+                    k += 1;
+                }
+                if k == rows.len() || rows[k] != r {
+                    return None;
+                }
+                slots[k] += v;
             }
+        }
+        Some(SparseColMat::new(self.gram.clone(), values))
+    }
+}
+
+/// AᵀA (`gram`) factored with its own analysis, and the ridge it took (see [`LeastSquares::new`]).
+fn factor_anew(
+    gram: &SparseColMat<usize, f64>,
+    rows: usize,
+    cols: usize,
+) -> Result<(Llt<usize, f64>, f64), EmbeddingError> {
+    if let Ok(factor) = gram.sp_cholesky(faer::Side::Lower) {
+        return Ok((factor, 0.0));
+    }
+    let ridge = EPSILON * EPSILON;
+    let diagonal: Vec<_> = (0..cols).map(|c| Triplet::new(c, c, ridge)).collect();
+    let shift = SparseColMat::<usize, f64>::try_new_from_triplets(cols, cols, &diagonal)
+        .map_err(|e| failed(rows, cols, e))?;
+    let factor = (gram.as_ref() + shift.as_ref())
+        .sp_cholesky(faer::Side::Lower)
+        .map_err(|e| failed(rows, cols, e))?;
+    Ok((factor, ridge))
+}
+
+/// `ridge` added to every diagonal entry of `m` (whose pattern holds the whole diagonal).
+fn add_to_diagonal(m: &mut SparseColMat<usize, f64>, ridge: f64) {
+    for c in 0..m.ncols() {
+        let at = m.as_ref().row_idx_of_col_raw(c).binary_search(&c);
+        if let Ok(k) = at {
+            m.val_of_col_mut(c)[k] += ridge;
+        }
+    }
+}
+
+/// Where the normal equations' analysis comes from ([`LeastSquares::new`]).
+#[derive(Clone, Copy)]
+pub(crate) enum Analysis<'a> {
+    /// Made from AᵀA itself, once it is formed.
+    Here,
+    /// Made ahead.
+    Ahead(&'a NormalAnalysis),
+    /// Made by this on another thread while AᵀA is formed (AMD's ordering then costs no time
+    /// where a second core is free).
+    Alongside(&'a (dyn Fn() -> Result<NormalAnalysis, EmbeddingError> + Sync)),
+}
+
+/// A system's A, Aᵀ and AᵀA, and the seconds each took.
+pub(crate) struct Formed {
+    a: SparseColMat<usize, f64>,
+    at: SparseColMat<usize, f64>,
+    pub(crate) gram: SparseColMat<usize, f64>,
+    seconds: [f64; 3],
+}
+
+/// A (`rows` × `cols`, from `triplets`), Aᵀ and AᵀA.
+pub(crate) fn form(
+    rows: usize,
+    cols: usize,
+    triplets: &[Triplet<usize, usize, f64>],
+) -> Result<Formed, EmbeddingError> {
+    let start = std::time::Instant::now();
+    // Aᵀ straight from the rows where they come in order (as the fit writes them): no sort of
+    // the triplets, which took a third of forming AᵀA.
+    let at = match transpose_of_rows(rows, cols, triplets) {
+        Some(at) => at,
+        None => SparseColMat::<usize, f64>::try_new_from_triplets(rows, cols, triplets)
+            .map_err(|e| failed(rows, cols, e))?
+            .as_ref()
+            .transpose()
+            .to_col_major()
+            .map_err(|e| failed(rows, cols, e))?,
+    };
+    let built = start.elapsed().as_secs_f64();
+    let a = at
+        .as_ref()
+        .transpose()
+        .to_col_major()
+        .map_err(|e| failed(rows, cols, e))?;
+    let transposed = start.elapsed().as_secs_f64();
+    let gram = faer::sparse::linalg::matmul::sparse_sparse_matmul(
+        at.as_ref(),
+        a.as_ref(),
+        1.0,
+        faer::Par::Seq,
+    )
+    .map_err(|e| failed(rows, cols, e))?;
+    let formed = start.elapsed().as_secs_f64();
+    Ok(Formed {
+        a,
+        at,
+        gram,
+        seconds: [built, transposed - built, formed - transposed],
+    })
+}
+
+impl LeastSquares {
+    /// Factors AᵀA (A `rows` × `cols`, from `triplets`). Where no row reaches some column, or the
+    /// rows leave some combination undetermined, AᵀA is singular and its Cholesky factorization
+    /// fails; then AᵀA + ε² I is factored instead, which picks the smallest such combination and
+    /// moves a determined solution by about ε² of its size.
+    ///
+    /// With an analysis made ahead or alongside (from a pattern holding this system's) only the
+    /// numeric factorization is left; a system that reaches outside it is analysed here.
+    pub(crate) fn new(
+        rows: usize,
+        cols: usize,
+        triplets: &[Triplet<usize, usize, f64>],
+        analysis: Analysis<'_>,
+    ) -> Result<LeastSquares, EmbeddingError> {
+        let (formed, alongside) = match analysis {
+            Analysis::Alongside(make) => {
+                let (formed, made) = rayon::join(|| form(rows, cols, triplets), make);
+                (formed?, made.ok())
+            }
+            _ => (form(rows, cols, triplets)?, None),
         };
+        let start = std::time::Instant::now();
+        let analysis = match analysis {
+            Analysis::Here => None,
+            Analysis::Ahead(made) => Some(made),
+            Analysis::Alongside(_) => alongside.as_ref(),
+        };
+        let ahead = analysis.and_then(|made| Some((made, made.spread(&formed.gram)?)));
+        if analysis.is_some() && ahead.is_none() {
+            tracing::debug!("the system reaches outside the analysis made ahead: analysed anew");
+        }
+        let analysed_ahead = ahead.is_some();
+        let (factor, ridge) = match ahead {
+            Some((made, mut spread)) => {
+                let llt = |m: &SparseColMat<usize, f64>| {
+                    Llt::try_new_with_symbolic(made.cholesky.clone(), m.as_ref(), faer::Side::Lower)
+                };
+                match llt(&spread) {
+                    Ok(factor) => (factor, 0.0),
+                    Err(_) => {
+                        let ridge = EPSILON * EPSILON;
+                        add_to_diagonal(&mut spread, ridge);
+                        (llt(&spread).map_err(|e| failed(rows, cols, e))?, ridge)
+                    }
+                }
+            }
+            None => factor_anew(&formed.gram, rows, cols)?,
+        };
+        let [transpose_seconds, a_seconds, gram_seconds] = formed.seconds;
         tracing::debug!(
             rows,
             cols,
             nonzeros = triplets.len(),
             // Each step's own time: Aᵀ, A, AᵀA, its factorization.
-            transpose_seconds = built,
-            a_seconds = transposed - built,
-            gram_seconds = formed - transposed,
-            factor_seconds = start.elapsed().as_secs_f64() - formed,
+            transpose_seconds,
+            a_seconds,
+            gram_seconds,
+            factor_seconds = start.elapsed().as_secs_f64(),
+            analysed_ahead,
             "least squares factored"
         );
         Ok(LeastSquares {
-            a,
-            at,
+            a: formed.a,
+            at: formed.at,
             factor,
             ridge,
         })
@@ -208,19 +407,19 @@ mod tests {
                 (dense(&ours) - dense(&faers)).norm_max() < 1e-15,
                 "seed {seed}"
             );
-            let ordered = LeastSquares::new(rows, cols, &triplets)
+            let ordered = LeastSquares::new(rows, cols, &triplets, Analysis::Here)
                 .unwrap()
                 .solve(&rhs);
             triplets.reverse();
             assert!(transpose_of_rows(rows, cols, &triplets).is_none());
-            let reversed = LeastSquares::new(rows, cols, &triplets)
+            let reversed = LeastSquares::new(rows, cols, &triplets, Analysis::Here)
                 .unwrap()
                 .solve(&rhs);
             assert!((&ordered - &reversed).norm_max() < 1e-12, "seed {seed}");
         }
         let outside = [Triplet::new(0, 0, 1.0), Triplet::new(1, 5, 1.0)];
         assert!(transpose_of_rows(2, 5, &outside).is_none());
-        assert!(LeastSquares::new(2, 5, &outside).is_err());
+        assert!(LeastSquares::new(2, 5, &outside, Analysis::Here).is_err());
     }
 
     /// The sparse solution equals dense QR's on random well-posed systems; where a column is reached
@@ -238,17 +437,65 @@ mod tests {
                     .sum::<f64>()
             });
             let expected = dense.qr().solve_lstsq(&rhs);
-            let x = LeastSquares::new(rows, cols, &triplets)
+            let x = LeastSquares::new(rows, cols, &triplets, Analysis::Here)
                 .unwrap()
                 .solve(&rhs);
             assert!((&x - &expected).norm_max() < 1e-10, "seed {seed}");
 
             let (triplets, rhs) = random_system(rows, cols, seed, &[7]);
-            let x = LeastSquares::new(rows, cols, &triplets)
+            let x = LeastSquares::new(rows, cols, &triplets, Analysis::Here)
                 .unwrap()
                 .solve(&rhs);
             assert!(x.row(7).norm_max() < 1e-12, "seed {seed}: {:?}", x.row(7));
             assert!(x.norm_max() > 0.01, "seed {seed}");
         }
+    }
+
+    /// An analysis made ahead from a pattern holding the system's (its own rows and more) gives
+    /// the solution that factoring AᵀA from scratch gives, alongside or ahead, ridge included; a
+    /// system reaching outside the pattern is not spread onto it (and is analysed anew, to the
+    /// same solution).
+    #[test]
+    fn an_analysis_made_ahead_gives_the_same_solution() {
+        for seed in 1..=20u64 {
+            let (rows, cols) = (300, 120);
+            let unreached: &[usize] = if seed % 2 == 0 { &[7] } else { &[] };
+            let (triplets, rhs) = random_system(rows, cols, seed, unreached);
+            let (extra, _) = random_system(40, cols, seed + 100, unreached);
+            let entries = || {
+                let own = triplets.iter().map(|t| (t.row, t.col));
+                own.chain(extra.iter().map(|t| (rows + t.row, t.col)))
+            };
+            let analysis = NormalAnalysis::new(rows + 40, cols, entries()).unwrap();
+            let here = LeastSquares::new(rows, cols, &triplets, Analysis::Here)
+                .unwrap()
+                .solve(&rhs);
+            let ahead = LeastSquares::new(rows, cols, &triplets, Analysis::Ahead(&analysis))
+                .unwrap()
+                .solve(&rhs);
+            let make = || NormalAnalysis::new(rows + 40, cols, entries());
+            let alongside = LeastSquares::new(rows, cols, &triplets, Analysis::Alongside(&make))
+                .unwrap()
+                .solve(&rhs);
+            assert!((&here - &ahead).norm_max() < 1e-12, "seed {seed}");
+            assert!((&here - &alongside).norm_max() < 1e-12, "seed {seed}");
+            if seed % 2 == 0 {
+                assert!(ahead.row(7).norm_max() < 1e-12, "seed {seed}");
+            }
+            let formed = form(rows, cols, &triplets).unwrap();
+            assert!(analysis.spread(&formed.gram).is_some(), "seed {seed}");
+
+            // Only the extra rows: the system's own reach outside them.
+            let narrow = NormalAnalysis::new(40, cols, extra.iter().map(|t| (t.row, t.col)));
+            let narrow = narrow.unwrap();
+            assert!(narrow.spread(&formed.gram).is_none(), "seed {seed}");
+            let anew = LeastSquares::new(rows, cols, &triplets, Analysis::Ahead(&narrow))
+                .unwrap()
+                .solve(&rhs);
+            assert!((&here - &anew).norm_max() < 1e-12, "seed {seed}");
+        }
+        let backwards = [(1, 0), (0, 1)];
+        assert!(NormalAnalysis::new(2, 2, backwards.into_iter()).is_err());
+        assert!(NormalAnalysis::new(1, 2, [(0, 5)].into_iter()).is_err());
     }
 }
