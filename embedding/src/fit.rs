@@ -196,6 +196,11 @@ pub(crate) fn triangle_distortion(
 /// no vertex moves further than this.
 pub const RELAX_TOLERANCE: f64 = 1e-8;
 
+/// The tolerance of the stretch rounds before the last ([`Lifts::settle_rounds`]): their maps
+/// only measure the stretch that reweights the next, and a vertex off by this (in frame units,
+/// where neighbours are 10⁻² to 10⁻¹ apart) changes a triangle's area by about 10⁻⁴ of itself.
+pub const EARLY_ROUND_TOLERANCE: f64 = 1e-6;
+
 /// Gauss–Seidel sweeps before Newton's method takes over. From Floater's map, whose kinks along the
 /// cuts are far from the fixed point, Newton's first steps are short (damped); sweeps are cheap
 /// there and bring it close. Measured (plates at resolution 32, map time in s, 0 / 100 / 300
@@ -1157,16 +1162,7 @@ fn flatten(
 ) -> Result<Parameterization, EmbeddingError> {
     let hyperbolic = polygon.geometry() == Geometry::Hyperbolic;
     let (disk, flat, mut lifts) = floater_lifts(polygon, mesh)?;
-    let rounds = stretch_rounds + 1;
-    progress(FitStage::Relaxing { round: 1, rounds });
-    let mut kept = None;
-    let mut solved = lifts.settle(hyperbolic, &mut kept)?;
-    for round in 2..=rounds {
-        progress(FitStage::Relaxing { round, rounds });
-        let stretch = lifts.stretch(&mesh.positions, hyperbolic);
-        lifts.reweight(&stretch);
-        solved = solved.then(lifts.settle(hyperbolic, &mut kept)?);
-    }
+    let solved = lifts.settle_rounds(&mesh.positions, hyperbolic, stretch_rounds, progress)?;
     let folded = lifts.folded_triangles(hyperbolic);
     let copies = (0..disk.original.len() as u32)
         .map(|c| lifts.copy_position(&disk, c))
@@ -1369,7 +1365,40 @@ impl Lifts {
         }
     }
 
-    /// The map at its fixed point by Newton's method to [`RELAX_TOLERANCE`] (see
+    /// The map at its fixed point ([`Lifts::settle`]), then `stretch_rounds` rounds of
+    /// reweighting by the stretch against `positions` (the mesh's), each settled again; each round
+    /// told to `progress`.
+    ///
+    /// A round before the last is solved only to [`EARLY_ROUND_TOLERANCE`]: its map serves only
+    /// to measure the stretch, and the last round's fixed point is the map.
+    pub(crate) fn settle_rounds(
+        &mut self,
+        positions: &[Point3],
+        hyperbolic: bool,
+        stretch_rounds: usize,
+        progress: &dyn Fn(FitStage),
+    ) -> Result<Convergence, EmbeddingError> {
+        let rounds = stretch_rounds + 1;
+        let tolerance = |round: usize| {
+            if round < rounds {
+                EARLY_ROUND_TOLERANCE
+            } else {
+                RELAX_TOLERANCE
+            }
+        };
+        progress(FitStage::Relaxing { round: 1, rounds });
+        let mut kept = None;
+        let mut solved = self.settle(hyperbolic, tolerance(1), &mut kept)?;
+        for round in 2..=rounds {
+            progress(FitStage::Relaxing { round, rounds });
+            let stretch = self.stretch(positions, hyperbolic);
+            self.reweight(&stretch);
+            solved = solved.then(self.settle(hyperbolic, tolerance(round), &mut kept)?);
+        }
+        Ok(solved)
+    }
+
+    /// The map at its fixed point by Newton's method to `tolerance` (see
     /// [`crate::harmonic`]), which leaves its last Jacobian in `kept` for the next round.
     ///
     /// A first round (nothing kept) starts from Floater's map, far from the fixed point:
@@ -1381,6 +1410,7 @@ impl Lifts {
     pub(crate) fn settle(
         &mut self,
         hyperbolic: bool,
+        tolerance: f64,
         kept: &mut Option<crate::harmonic::KeptJacobian>,
     ) -> Result<Convergence, EmbeddingError> {
         let swept = if kept.is_none() {
@@ -1394,7 +1424,7 @@ impl Lifts {
         } else {
             0
         };
-        let mut solved = crate::harmonic::solve(self, hyperbolic, RELAX_TOLERANCE, kept)?;
+        let mut solved = crate::harmonic::solve(self, hyperbolic, tolerance, kept)?;
         solved.sweeps += swept;
         Ok(solved)
     }

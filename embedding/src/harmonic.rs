@@ -175,20 +175,9 @@ pub(crate) fn solve(
         }
         _ => (None, Analysis::new(pattern(lifts, hyperbolic))?),
     };
-    // The forcing term η: how far each step's linear system is solved (Eisenstat and Walker's
-    // second choice, safeguarded): loosely while F falls slowly (far from the fixed point, where
-    // the linear model is poor anyway), tightly as it falls fast.
-    let mut forcing = FORCING_MAX;
-    let mut previous: Option<f64> = None;
+    let mut forcing = Forcing::default();
     while report.residual > tolerance {
-        let now = norm2(&f);
-        if let Some(previous) = previous {
-            let chosen = FORCING_GAMMA * (now / previous).powi(2);
-            let kept = FORCING_GAMMA * forcing * forcing;
-            forcing = if kept > 0.1 { chosen.max(kept) } else { chosen };
-            forcing = forcing.clamp(FORCING_MIN, FORCING_MAX);
-        }
-        previous = Some(now);
+        let forcing = forcing.next(norm2(&f));
         if report.steps == MAX_STEPS {
             return Err(EmbeddingError::Parameterization(format!(
                 "the map did not converge in {MAX_STEPS} Newton steps (largest residual {:.2e})",
@@ -248,6 +237,38 @@ pub(crate) fn solve(
         analysis,
     });
     Ok(report)
+}
+
+/// The forcing term η of each Newton step: how far its linear system is solved. Eisenstat and
+/// Walker's second choice, safeguarded: loosely while F falls slowly (far from the fixed point,
+/// where the linear model is poor anyway), tightly as it falls fast.
+struct Forcing {
+    eta: f64,
+    /// ‖F‖₂ at the step before.
+    previous: Option<f64>,
+}
+
+impl Default for Forcing {
+    fn default() -> Self {
+        Forcing {
+            eta: FORCING_MAX,
+            previous: None,
+        }
+    }
+}
+
+impl Forcing {
+    /// η for a step from a map whose ‖F‖₂ is `now`.
+    fn next(&mut self, now: f64) -> f64 {
+        if let Some(previous) = self.previous {
+            let chosen = FORCING_GAMMA * (now / previous).powi(2);
+            let kept = FORCING_GAMMA * self.eta * self.eta;
+            let eta = if kept > 0.1 { chosen.max(kept) } else { chosen };
+            self.eta = eta.clamp(FORCING_MIN, FORCING_MAX);
+        }
+        self.previous = Some(now);
+        self.eta
+    }
 }
 
 /// The Jacobian's analysis, and its factorization where one was made, kept from one solve for the

@@ -645,16 +645,8 @@ fn map_to_polygon(
         closure_error,
         mut lifts,
     } = best_marking(he, positions, triangles, areas, polygon, &length)?;
-    let rounds = fit_settings.stretch_rounds + 1;
-    progress(FitStage::Relaxing { round: 1, rounds });
-    let mut kept = None;
-    let mut solved = lifts.settle(hyperbolic, &mut kept)?;
-    for round in 2..=rounds {
-        progress(FitStage::Relaxing { round, rounds });
-        let stretch = lifts.stretch(positions, hyperbolic);
-        lifts.reweight(&stretch);
-        solved = solved.then(lifts.settle(hyperbolic, &mut kept)?);
-    }
+    let solved =
+        lifts.settle_rounds(positions, hyperbolic, fit_settings.stretch_rounds, progress)?;
     let sweeps = solved.sweeps;
     let folded = lifts.folded_triangles(hyperbolic);
     let distortion = lifts.distortion(positions, hyperbolic);
