@@ -322,6 +322,21 @@ pub const MAX_FIT_TRIANGLES: usize = 400_000;
 /// genus 17 to 33 before), genus 25 to 31 34–41 s → 46–56 s, 34 to 40 50–60 s → 67–74 s.
 pub const DEFAULT_FIT_TRIANGLES: usize = 300_000;
 
+/// The budget [`default_resolution`] keeps [`HIGH_GRID_GENERA`]'s plates within: their finer
+/// grid needs the data as dense. With it genus 30 takes resolution 32 (373 176 triangles), 31
+/// and 32 take 30 (356 334 and 377 252; the step down from 32 aims 3% under the budget).
+pub const HIGH_GRID_FIT_TRIANGLES: usize = 395_000;
+const _: () = assert!(HIGH_GRID_FIT_TRIANGLES <= MAX_FIT_TRIANGLES);
+
+/// The most input triangles [`default_resolution`] chooses for `genus`.
+pub fn fit_triangle_budget(genus: u32) -> usize {
+    if HIGH_GRID_GENERA.contains(&genus) {
+        HIGH_GRID_FIT_TRIANGLES
+    } else {
+        DEFAULT_FIT_TRIANGLES
+    }
+}
+
 /// A stage of [`initial_model_with_progress`], for progress displays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FitStage {
@@ -432,16 +447,46 @@ pub const FINE_RESOLUTION_GENERA: [std::ops::RangeInclusive<u32>; 1] = [3..=16];
 /// |E_u| ≈ 70–80 against the edge charts' 3–6 (the `spot_report` example): there one grid cell
 /// spans about 2 model units, more than the rim's rounded edge. The lever is a finer grid in those
 /// two charts, or blends that hand the rim to the edge charts, not a finer grid everywhere.
+///
+/// Genus 30 to 32 ([`HIGH_GRID_GENERA`]) take [`HIGH_GRID`].
 pub fn default_grid(genus: u32) -> usize {
     if genus <= 1 {
         SplineSettings::default().grid
+    } else if HIGH_GRID_GENERA.contains(&genus) {
+        HIGH_GRID
     } else {
         FINE_GRID
     }
 }
 
-/// The grid [`default_grid`] gives from genus 2 on.
+/// The grid [`default_grid`] gives from genus 2 on, but for [`HIGH_GRID_GENERA`].
 pub const FINE_GRID: usize = 48;
+
+/// The genera whose plates take the finer grid [`HIGH_GRID`] (and, with it, the finer input mesh
+/// of [`HIGH_GRID_FIT_TRIANGLES`]).
+///
+/// Why: at genus 32 on the grid of 48 the largest |κ| (1.70× the input's, over the Gauss–Bonnet
+/// quadrature's points; 1.54× over a t = 128 tessellation's) sat on the outer rim's rounded edge
+/// inside an edge chart (blend 0.92–0.94), where that chart's own patch bent to κ = −6.7 against
+/// the rim's 4.0, its parameterization sheared there (E_u and E_v 148° apart). A finer input mesh
+/// alone left it (resolution 26 → 28 → 30: 1.70× → 1.70× → 1.69×); a finer grid alone helped at
+/// 56 (1.54×) and hurt at 64 (1.83×: the data grew sparse between knots); both together brought
+/// it under 1.5× (`ntori new --genus G --grid g --resolution r`: largest |κ| against the input's,
+/// flat faces' |H| × half-thickness and normals at the 90th percentile, time):
+///
+/// | genus | grid 48, defaults | grid 64, resolution | flat faces | normals | time |
+/// |---|---|---|---|---|---|
+/// | 30 | 1.53× | 1.31×, 31 | 0.0068 | 0.14° | 63 s |
+/// | 31 | 1.71× | 1.49×, 30 | 0.0075 | 0.17° | 63 s |
+/// | 32 | 1.70× (43 s) | 1.47×, 30 | 0.0070 | 0.16° | 67 s |
+///
+/// (grid 56 at resolution 30: genus 32 1.51×; 60: 1.48×.) Genus 29 and below read 1.40× and less
+/// on 48 already.
+pub const HIGH_GRID_GENERA: std::ops::RangeInclusive<u32> = 30..=32;
+
+/// The edge charts' grid for [`HIGH_GRID_GENERA`] (the disk charts' follows it,
+/// [`default_disk_grid`]).
+pub const HIGH_GRID: usize = 64;
 
 /// The disk charts' grid `ntori new` uses for `genus` and an edge-chart `grid` where none is
 /// chosen (`None`: the same as the edge charts'): twice `grid` from genus 3, 8/3 of it at genus
@@ -830,10 +875,11 @@ pub fn default_resolution(genus: u32) -> Result<usize, EmbeddingError> {
             Err(EmbeddingError::FitTooLarge { triangles, .. }) if resolution > 8 => triangles,
             Err(e) => return Err(e),
         };
-        if triangles <= DEFAULT_FIT_TRIANGLES || resolution <= 8 {
+        let budget = fit_triangle_budget(genus);
+        if triangles <= budget || resolution <= 8 {
             return Ok(resolution);
         }
-        let scale = (DEFAULT_FIT_TRIANGLES as f64 / triangles as f64).sqrt();
+        let scale = (budget as f64 / triangles as f64).sqrt();
         resolution = ((0.97 * scale * resolution as f64) as usize).clamp(8, resolution - 1);
     }
 }

@@ -73,6 +73,7 @@ fn transpose_of_rows(
 /// values, so the fit makes it on another thread while it works the rows' values out (the
 /// arc-length rows need a first, coarse fit): at genus 10 AMD alone took about half a second.
 pub(crate) struct NormalAnalysis {
+    /// AᵀA's lower triangle (the Cholesky factorization reads no more).
     gram: SymbolicSparseColMat<usize>,
     cholesky: SymbolicLlt<usize>,
 }
@@ -114,21 +115,19 @@ impl NormalAnalysis {
             row_idx.push(c);
             col_ptr.push(row_idx.len());
         }
-        let ones = vec![1.0; row_idx.len()];
-        let at = SparseColMat::new(
-            SymbolicSparseColMat::new_checked(cols, rows + cols, col_ptr, None, row_idx),
-            ones,
-        );
+        // Patterns only (no values: this runs while the other core forms the system itself, and
+        // the two at once set the fit's peak memory).
+        let at = SymbolicSparseColMat::new_checked(cols, rows + cols, col_ptr, None, row_idx);
         let a = at
             .as_ref()
             .transpose()
             .to_col_major()
             .map_err(|e| failed(rows, cols, e))?;
-        let (gram, _) = faer::sparse::linalg::matmul::sparse_sparse_matmul_symbolic(
-            at.symbolic(),
-            a.symbolic(),
-        )
-        .map_err(|e| failed(rows, cols, e))?;
+        let (gram, _) =
+            faer::sparse::linalg::matmul::sparse_sparse_matmul_symbolic(at.as_ref(), a.as_ref())
+                .map_err(|e| failed(rows, cols, e))?;
+        drop((at, a));
+        let gram = lower_triangle(&gram);
         let formed = start.elapsed().as_secs_f64();
         let cholesky = SymbolicLlt::try_new(gram.as_ref(), faer::Side::Lower)
             .map_err(|e| failed(rows, cols, e))?;
@@ -142,8 +141,8 @@ impl NormalAnalysis {
         Ok(NormalAnalysis { gram, cholesky })
     }
 
-    /// `gram`'s values on this analysis's pattern (zeros where it has none), or `None` where
-    /// `gram` has an entry outside it.
+    /// The lower triangle of `gram` (AᵀA) on this analysis's pattern (zeros where it has none),
+    /// or `None` where `gram` has an entry outside it.
     pub(crate) fn spread(
         &self,
         gram: &SparseColMat<usize, f64>,
@@ -157,12 +156,12 @@ impl NormalAnalysis {
             let range = pattern.col_range(c);
             let (rows, slots) = (&pattern.row_idx()[range.clone()], &mut values[range]);
             let mut k = 0;
-            for (&r, &v) in gram
+            let entries = gram
                 .as_ref()
                 .row_idx_of_col_raw(c)
                 .iter()
-                .zip(gram.val_of_col(c))
-            {
+                .zip(gram.val_of_col(c));
+            for (&r, &v) in entries.filter(|(r, _)| **r >= c) {
                 // Both columns are sorted: a merge.
                 while k < rows.len() && rows[k] < r {
                     k += 1;
@@ -175,6 +174,18 @@ impl NormalAnalysis {
         }
         Some(SparseColMat::new(self.gram.clone(), values))
     }
+}
+
+/// The lower triangle (diagonal included) of the sorted pattern `m`.
+fn lower_triangle(m: &SymbolicSparseColMat<usize>) -> SymbolicSparseColMat<usize> {
+    let mut col_ptr = Vec::with_capacity(m.ncols() + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for c in 0..m.ncols() {
+        row_idx.extend(m.as_ref().row_idx_of_col_raw(c).iter().filter(|&&r| r >= c));
+        col_ptr.push(row_idx.len());
+    }
+    SymbolicSparseColMat::new_checked(m.nrows(), m.ncols(), col_ptr, None, row_idx)
 }
 
 /// AᵀA (`gram`) factored with its own analysis, and the ridge it took (see [`LeastSquares::new`]).
@@ -294,13 +305,21 @@ impl LeastSquares {
             Analysis::Ahead(made) => Some(made),
             Analysis::Alongside(_) => alongside.as_ref(),
         };
-        let ahead = analysis.and_then(|made| Some((made, made.spread(&formed.gram)?)));
+        let Formed {
+            a,
+            at,
+            gram,
+            seconds: [transpose_seconds, a_seconds, gram_seconds],
+        } = formed;
+        let ahead = analysis.and_then(|made| Some((made, made.spread(&gram)?)));
         if analysis.is_some() && ahead.is_none() {
             tracing::debug!("the system reaches outside the analysis made ahead: analysed anew");
         }
         let analysed_ahead = ahead.is_some();
         let (factor, ridge) = match ahead {
             Some((made, mut spread)) => {
+                // Its lower triangle is all the factorization reads: AᵀA itself can go first.
+                drop(gram);
                 let llt = |m: &SparseColMat<usize, f64>| {
                     Llt::try_new_with_symbolic(made.cholesky.clone(), m.as_ref(), faer::Side::Lower)
                 };
@@ -313,9 +332,8 @@ impl LeastSquares {
                     }
                 }
             }
-            None => factor_anew(&formed.gram, rows, cols)?,
+            None => factor_anew(&gram, rows, cols)?,
         };
-        let [transpose_seconds, a_seconds, gram_seconds] = formed.seconds;
         tracing::debug!(
             rows,
             cols,
@@ -329,8 +347,8 @@ impl LeastSquares {
             "least squares factored"
         );
         Ok(LeastSquares {
-            a: formed.a,
-            at: formed.at,
+            a,
+            at,
             factor,
             ridge,
         })

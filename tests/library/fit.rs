@@ -480,7 +480,9 @@ fn the_default_genus_2_plates_flat_faces_lie_flat() {
 /// finer grid gets a stronger smoothness weight unless one is chosen.
 #[test]
 fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smoothing() {
-    use embedding::fit::{FINE_GRID, default_grid, default_settings, default_smoothness};
+    use embedding::fit::{
+        FINE_GRID, HIGH_GRID, HIGH_GRID_GENERA, default_grid, default_settings, default_smoothness,
+    };
     for genus in 0..=1 {
         assert_eq!(
             default_grid(genus),
@@ -488,10 +490,15 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
             "genus {genus}"
         );
     }
-    for genus in [2, 3, 5, 10, 16, 21, 24, 32, 64] {
+    for genus in [2, 3, 5, 10, 16, 21, 24, 29, 33, 64] {
         assert_eq!(default_grid(genus), FINE_GRID, "genus {genus}");
     }
-    assert!(FINE_GRID > SplineSettings::default().grid);
+    // Genus 30 to 32's outer rims need the finer grid (with the finer mesh: see the next test).
+    for genus in 30..=32 {
+        assert!(HIGH_GRID_GENERA.contains(&genus));
+        assert_eq!(default_grid(genus), HIGH_GRID, "genus {genus}");
+    }
+    assert!(FINE_GRID > SplineSettings::default().grid && HIGH_GRID > FINE_GRID);
     let base = FitSettings::default().smoothness;
     assert_eq!(default_smoothness(SplineSettings::default().grid), base);
     assert_eq!(default_smoothness(20), base);
@@ -558,8 +565,8 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
 #[test]
 fn the_default_resolution_keeps_high_genus_within_the_fit() {
     use embedding::fit::{
-        DEFAULT_FIT_TRIANGLES, DEFAULT_RESOLUTION, FINE_RESOLUTION, MAX_FIT_TRIANGLES,
-        TORUS_RESOLUTION, default_resolution,
+        DEFAULT_FIT_TRIANGLES, DEFAULT_RESOLUTION, FINE_RESOLUTION, HIGH_GRID_FIT_TRIANGLES,
+        MAX_FIT_TRIANGLES, TORUS_RESOLUTION, default_resolution, fit_triangle_budget,
     };
     for genus in [0, 2, 17, 20] {
         assert_eq!(default_resolution(genus).unwrap(), DEFAULT_RESOLUTION);
@@ -576,14 +583,26 @@ fn the_default_resolution_keeps_high_genus_within_the_fit() {
             "genus {genus}: {triangles}"
         );
     }
-    for genus in [28, 32, 48] {
+    for genus in [28, 31, 32, 48] {
         let resolution = default_resolution(genus).unwrap();
         let triangles = HoledMesh::new(genus, resolution).unwrap().triangles.len();
+        let budget = fit_triangle_budget(genus);
         eprintln!("genus {genus}: resolution {resolution}, {triangles} triangles");
         assert!(resolution < DEFAULT_RESOLUTION, "genus {genus}");
         assert!(
-            triangles <= DEFAULT_FIT_TRIANGLES && 10 * triangles >= 8 * DEFAULT_FIT_TRIANGLES,
+            triangles <= budget && 10 * triangles >= 8 * budget,
             "genus {genus}: {triangles} triangles at resolution {resolution}"
+        );
+    }
+    // Genus 30 to 32 on their finer grid: the meshes measured with it (31 and 32 at 30; 30 at its
+    // full 32), within the fit's cap.
+    assert_eq!(fit_triangle_budget(31), HIGH_GRID_FIT_TRIANGLES);
+    assert_eq!(fit_triangle_budget(29), DEFAULT_FIT_TRIANGLES);
+    for (genus, resolution) in [(30, 32), (31, 30), (32, 30)] {
+        assert_eq!(
+            default_resolution(genus).unwrap(),
+            resolution,
+            "genus {genus}"
         );
     }
     // Genus 64's coarsest mesh: within the fit's cap, and within the default budget since that
