@@ -196,7 +196,7 @@ pub(crate) fn triangle_distortion(
 /// no vertex moves further than this.
 pub const RELAX_TOLERANCE: f64 = 1e-8;
 
-/// The tolerance of the stretch rounds before the last ([`Lifts::settle_rounds`]): their maps
+/// The tolerance of the stretch rounds before the last (`Lifts::settle_rounds`): their maps
 /// only measure the stretch that reweights the next, and a vertex off by this (in frame units,
 /// where neighbours are 10⁻² to 10⁻¹ apart) changes a triangle's area by about 10⁻⁴ of itself.
 pub const EARLY_ROUND_TOLERANCE: f64 = 1e-6;
