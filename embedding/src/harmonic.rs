@@ -506,7 +506,9 @@ fn krylov_step(
         seconds = started.elapsed().as_secs_f64(),
         "map's Newton step by GMRES"
     );
-    solved.map(|(x, _)| unpack(&x, n, hyperbolic)).transpose()
+    // A step that is not finite is no step: the caller factors the current Jacobian instead (and
+    // that one reports a singular Jacobian).
+    Ok(solved.and_then(|(x, _)| unpack(&x, n, hyperbolic).ok()))
 }
 
 /// GMRES without restarts, preconditioned on the right by the factored `m`: x with
@@ -549,6 +551,10 @@ fn gmres(
             h[i + 1] = -s * x + c * y;
         }
         let r = h[k].hypot(h[k + 1]);
+        if !(r > 0.0 && r.is_finite()) {
+            // A breakdown (or a product that is not finite): the caller factors afresh.
+            return None;
+        }
         let (c, s) = (h[k] / r, h[k + 1] / r);
         h[k] = r;
         h.truncate(k + 1);
@@ -664,6 +670,13 @@ mod tests {
             assert!(
                 gmres(a.as_ref(), &lu, &b, threshold, 1).is_none(),
                 "case {case}: one iteration claimed 1e-8"
+            );
+            // A breakdown (here a zero matrix: no direction reduces the residual) is a failure to
+            // converge, not a step of NaNs.
+            let zero = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &[]).unwrap();
+            assert!(
+                gmres(zero.as_ref(), &lu, &b, threshold, 5).is_none(),
+                "case {case}"
             );
         }
     }
