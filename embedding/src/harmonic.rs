@@ -615,6 +615,18 @@ mod tests {
             .fold(0.0, f64::max)
     }
 
+    /// Reproducible numbers in [−1, 1) from `seed` (SplitMix64), without a generator crate.
+    fn uniform_numbers(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut x = state;
+            x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            (x ^ (x >> 31)) as f64 / u64::MAX as f64 * 2.0 - 1.0
+        }
+    }
+
     fn copy(lifts: &Lifts) -> Lifts {
         Lifts::from_parts(
             lifts.home.clone(),
@@ -629,14 +641,7 @@ mod tests {
     /// residual; with too few iterations it says so rather than return a poor x.
     #[test]
     fn gmres_solves_to_its_threshold_with_a_nearby_factorization() {
-        let mut state = 7u64;
-        let mut uniform = || {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut x = state;
-            x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            (x ^ (x >> 31)) as f64 / u64::MAX as f64 * 2.0 - 1.0
-        };
+        let mut uniform = uniform_numbers(7);
         for case in 0..20 {
             let n = 200 + 37 * case;
             let (mut exact, mut nearby) = (Vec::new(), Vec::new());
@@ -685,15 +690,7 @@ mod tests {
     /// the fixed point) for the torus and genus 2 to 5.
     #[test]
     fn the_jacobian_is_the_residual_s_derivative() {
-        // SplitMix64: reproducible numbers in [−1, 1) without a generator crate.
-        let mut state = 12u64;
-        let mut uniform = || {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut x = state;
-            x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            (x ^ (x >> 31)) as f64 / u64::MAX as f64 * 2.0 - 1.0
-        };
+        let mut uniform = uniform_numbers(12);
         for genus in 1..=5 {
             let (mut lifts, hyperbolic) = start(genus, 8);
             let n = lifts.home.len();
