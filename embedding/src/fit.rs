@@ -448,16 +448,60 @@ pub const FINE_RESOLUTION_GENERA: [std::ops::RangeInclusive<u32>; 1] = [3..=16];
 /// spans about 2 model units, more than the rim's rounded edge. The lever is a finer grid in those
 /// two charts, or blends that hand the rim to the edge charts, not a finer grid everywhere.
 ///
-/// Genus 30 to 32 ([`HIGH_GRID_GENERA`]) take [`HIGH_GRID`].
+/// Genus 30 to 32 ([`HIGH_GRID_GENERA`]) take [`HIGH_GRID`], genus 5 to 16
+/// ([`FINE_DISK_GENERA`]) the coarser [`FINE_DISK_EDGE_GRID`] with finer disk charts.
 pub fn default_grid(genus: u32) -> usize {
     if genus <= 1 {
         SplineSettings::default().grid
     } else if HIGH_GRID_GENERA.contains(&genus) {
         HIGH_GRID
+    } else if FINE_DISK_GENERA.contains(&genus) {
+        FINE_DISK_EDGE_GRID
     } else {
         FINE_GRID
     }
 }
+
+/// The genera whose control points are moved from the edge charts to the disk charts: their
+/// edge charts take [`FINE_DISK_EDGE_GRID`] ([`default_grid`]) and their disk charts three or
+/// four times that ([`default_disk_grid`]).
+///
+/// From genus 5 the vertex chart carries the flat faces' strips between the holes and the outer
+/// rim near its own rim, where its Poincaré coordinates stretch: a cell there spanned 0.21–0.31
+/// model units at genus 10 (disk grid 96), against 0.05–0.12 in the edge charts beside it. That
+/// patch rippled at its cells' scale, by about 10⁻⁴ in z, and the ripple showed as the
+/// mean-curvature pictures' hairlines, in red and blue stripes along its fringe (the patch's own
+/// H carried them; the blend's derivatives added little). A finer disk grid removes them; a finer
+/// edge grid barely matters, so the edge charts pay for it and genus 10's fit keeps its time
+/// (the fit bench's 5 s).
+///
+/// Measured with `ntori new` (largest |κ| against the input's; the flat faces' |H|·T at the 90th
+/// percentile at the input's vertices) and, for the hairlines, |H| times the half-thickness T over
+/// a t = 128 tessellation's points on the top face at least 0.05 inside its flat part (about a
+/// million at genus 10): the 99.9th percentile, the largest, and how many points exceed 0.05.
+/// Edge grid and disk grid before → after:
+///
+/// | genus | grids | \|κ\| | flat faces | 99.9% | largest | > 0.05 |
+/// |---|---|---|---|---|---|---|
+/// | 5 | 48/96 → 40/120 | 1.10× → 1.11× | 0.0080 → 0.0076 | 0.043 → 0.026 | 0.079 → 0.062 | 188 → 16 |
+/// | 8 | 48/96 → 40/120 | 1.10× → 1.11× | 0.0101 → 0.0073 | 0.066 → 0.042 | 0.093 → 0.085 | 2978 → 311 |
+/// | 10 | 48/96 → 40/120 | 1.12× → 1.14× | 0.0112 → 0.0080 | 0.067 → 0.049 | 0.106 → 0.085 | 4023 → 939 |
+/// | 12 | 48/96 → 40/160 | 1.23× → 1.12× | 0.0137 → 0.0060 | 0.078 → 0.039 | 0.143 → 0.082 | 8360 → 270 |
+/// | 15 | 48/96 → 40/160 | 1.34× → 1.19× | 0.0145 → 0.0060 | 0.089 → 0.045 | 0.202 → 0.086 | 11919 → 973 |
+/// | 16 | 48/128 → 40/160 | 1.20× → 1.17× | 0.0112 → 0.0075 | 0.079 → 0.064 | 0.216 → 0.184 | 9038 → 4474 |
+///
+/// Genus 10's fit (the `initial_fit` bench's pipeline, best of two, runs alternated): 4.81 s at
+/// 48/96, 4.77–4.85 s at 40/120, 5.27–5.41 s at 44/120 and 5.47–5.52 s at 44/128. 44/136 and
+/// 44/160 (genus 10, 12, 15) were a little smoother still, for 0.5–1.3 s more. Genus 3 and 4
+/// keep 48/96: they showed no hairline (no point above 0.05 at genus 3, 8 at genus 4), and at
+/// 40/120 genus 3's |κ| rose from 1.12× to 1.15×. Genus 16 keeps ripples at its outer rim's ends
+/// in its edge charts' own patches, where their cells (0.04–0.10 units) are finer than the
+/// input's spacing; so do genus 17 and up (genus 24: 32 537 points above 0.05, 15 155 at
+/// resolution 40; λ three times larger 27 968).
+pub const FINE_DISK_GENERA: std::ops::RangeInclusive<u32> = 5..=16;
+
+/// The edge charts' grid for [`FINE_DISK_GENERA`].
+pub const FINE_DISK_EDGE_GRID: usize = 40;
 
 /// The grid [`default_grid`] gives from genus 2 on, but for [`HIGH_GRID_GENERA`].
 pub const FINE_GRID: usize = 48;
@@ -489,9 +533,10 @@ pub const HIGH_GRID_GENERA: std::ops::RangeInclusive<u32> = 30..=32;
 pub const HIGH_GRID: usize = 64;
 
 /// The disk charts' grid `ntori new` uses for `genus` and an edge-chart `grid` where none is
-/// chosen (`None`: the same as the edge charts'): twice `grid` from genus 3, 8/3 of it at genus
-/// 16, 16/3 from genus 17 and 8 times from genus 34 (96, 128, 256 and 384 at the default 48),
-/// rounded to a multiple of 8.
+/// chosen (`None`: the same as the edge charts'): twice `grid` at genus 3 and 4 (96 at their 48),
+/// three times from genus 5 and four times from 11 (120 and 160 at [`FINE_DISK_EDGE_GRID`], see
+/// [`FINE_DISK_GENERA`]), 16/3 from genus 17 and 8 times from genus 34 (256 and 384 at 48),
+/// rounded up to a multiple of 8. (Genus 16 took 8/3 of 48, 128, before [`FINE_DISK_GENERA`].)
 ///
 /// The inside and vertex charts are each a disk about a point whose hyperbolic neighbourhood
 /// holds well over half the surface: the plate's bottom and top faces and, at their rims, the
@@ -533,8 +578,9 @@ pub const HIGH_GRID: usize = 64;
 /// | 31 | 5.17× (refused), 0.0216 | 4.28× (refused), 0.0187 |
 ///
 /// With 256 the agreement rows pay from genus 17 ([`plate_agreement`]), which bring 28 and 31
-/// within `new`'s check; at 128 they made the peaks worse. Genus 16 keeps 128: 256 left its largest
+/// within `new`'s check; at 128 they made the peaks worse. Genus 16 kept 128 then: 256 left its largest
 /// |κ| where it was (1.33×) for 0.9 GB more, though its flat faces read 0.0075 against 0.0149.
+/// It now takes 160 on edge charts of 40 ([`FINE_DISK_GENERA`]).
 ///
 /// From genus 34 it is 8 times the grid (384): with the agreement rows, genus 34 to 39 read 3.1× to
 /// 4.1× at 256, which `new` refuses (3×), and 2.7× to 2.9× at 384 (34, 35, 37), for about 4.1 GB
@@ -554,8 +600,9 @@ pub const HIGH_GRID: usize = 64;
 pub fn default_disk_grid(genus: u32, grid: usize) -> Option<usize> {
     let (num, den) = match genus {
         0..=2 => return None,
-        3..=15 => (2, 1),
-        16 => (8, 3),
+        3..=4 => (2, 1),
+        5..=10 => (3, 1),
+        11..=16 => (4, 1),
         17..=33 => (16, 3),
         _ => (8, 1),
     };

@@ -96,14 +96,16 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct FitArgs {
     /// Control points per side of each chart's grid [default: for new 32 for the sphere and the
-    /// torus and 48 from genus 2 (a coarser grid ripples there); for fit 40, and 80 for a genus-0 mesh (its two
+    /// torus and 48 from genus 2 (a coarser grid ripples there), but 40 from genus 5 to 16 (whose
+    /// disk charts take the finer grids) and 64 at genus 30 to 32; for fit 40, and 80 for a genus-0 mesh (its two
     /// charts carry the whole surface); 32 for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=MAX_GRID))]
     grid: Option<u64>,
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
-    /// the grid from genus 3 (96 at 48), 8/3 of it at genus 16 (128), 16/3 from genus 17 (256)
-    /// and 8 times from genus 34 (384), the grid below genus 3; for fit twice the grid from genus
+    /// the grid at genus 3 and 4 (96 at 48), three times from genus 5 (120 at 40), four times
+    /// from genus 11 (160 at 40), 16/3 from genus 17 (256 at 48) and 8 times from genus 34
+    /// (384), the grid below genus 3; for fit twice the grid from genus
     /// 2 (80 at 40), the grid below; the grid for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=512))]
     disk_grid: Option<u64>,

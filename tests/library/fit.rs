@@ -490,9 +490,26 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
             "genus {genus}"
         );
     }
-    for genus in [2, 3, 5, 10, 16, 21, 24, 29, 33, 64] {
+    for genus in [2, 3, 4, 17, 21, 24, 29, 33, 64] {
         assert_eq!(default_grid(genus), FINE_GRID, "genus {genus}");
     }
+    // Genus 5 to 16 move control points from the edge charts to the disk charts, whose rims
+    // carried the flat faces' hairlines: three times the edge grid to genus 10, four to 16.
+    use embedding::fit::{FINE_DISK_EDGE_GRID, FINE_DISK_GENERA, default_disk_grid};
+    for genus in 5..=16 {
+        assert!(FINE_DISK_GENERA.contains(&genus));
+        assert_eq!(default_grid(genus), FINE_DISK_EDGE_GRID, "genus {genus}");
+        let times = if genus <= 10 { 3 } else { 4 };
+        assert_eq!(
+            default_disk_grid(genus, FINE_DISK_EDGE_GRID),
+            Some(times * FINE_DISK_EDGE_GRID),
+            "genus {genus}"
+        );
+    }
+    assert!(!FINE_DISK_GENERA.contains(&4) && !FINE_DISK_GENERA.contains(&17));
+    assert_eq!(default_disk_grid(3, FINE_GRID), Some(2 * FINE_GRID));
+    assert_eq!(default_disk_grid(2, FINE_GRID), None);
+    assert!(FINE_DISK_EDGE_GRID > SplineSettings::default().grid);
     // Genus 30 to 32's outer rims need the finer grid (with the finer mesh: see the next test).
     for genus in 30..=32 {
         assert!(HIGH_GRID_GENERA.contains(&genus));
