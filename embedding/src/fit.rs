@@ -503,7 +503,8 @@ pub const FINE_DISK_GENERA: std::ops::RangeInclusive<u32> = 5..=16;
 /// The edge charts' grid for [`FINE_DISK_GENERA`].
 pub const FINE_DISK_EDGE_GRID: usize = 40;
 
-/// The grid [`default_grid`] gives from genus 2 on, but for [`HIGH_GRID_GENERA`].
+/// The grid [`default_grid`] gives from genus 2 on, but for [`FINE_DISK_GENERA`] and
+/// [`HIGH_GRID_GENERA`].
 pub const FINE_GRID: usize = 48;
 
 /// The genera whose plates take the finer grid [`HIGH_GRID`] (and, with it, the finer input mesh

@@ -109,7 +109,7 @@ fn jacobian(lifts: &Lifts, hyperbolic: bool) -> Vec<Triplet<usize, usize, f64>> 
         for (i, line) in m.iter().enumerate() {
             for (j, &x) in line.iter().enumerate() {
                 // Zeros too: the pattern must not change between factorizations, which share
-                // one symbolic analysis (see `factorize`).
+                // one symbolic analysis (see `Analysis`).
                 triplets.push(Triplet::new(2 * row + i, 2 * col + j, x));
             }
         }
@@ -176,6 +176,10 @@ pub(crate) fn solve(
         _ => (None, Analysis::new(pattern(lifts, hyperbolic))?),
     };
     let mut forcing = Forcing::default();
+    // The Jacobian at the current map where a GMRES step has assembled it already: a
+    // factorization that follows there (GMRES failed, or its step found no decrease and the map
+    // went back) takes it instead of assembling it again. Cleared whenever the map moves.
+    let mut here: Option<SparseColMat<usize, f64>> = None;
     while report.residual > tolerance {
         let forcing = forcing.next(norm2(&f));
         if report.steps == MAX_STEPS {
@@ -186,8 +190,11 @@ pub(crate) fn solve(
         }
         report.steps += 1;
         let earlier = match factor.take() {
-            Some(lu) => krylov_step(lifts, hyperbolic, &analysis, &lu, &f, forcing, tolerance)?
-                .map(|step| (lu, step)),
+            Some(lu) => {
+                let j = here.insert(analysis.jacobian(lifts, hyperbolic)?);
+                krylov_step(j, lifts, hyperbolic, &lu, &f, forcing, tolerance)
+                    .map(|step| (lu, step))
+            }
             None => None,
         };
         let (lu, (step, drift_step), fresh) = match earlier {
@@ -196,7 +203,11 @@ pub(crate) fn solve(
                 // Any earlier factorization is dropped by now: two LUs at once would double the
                 // map's peak memory.
                 report.factorizations += 1;
-                let lu = analysis.factorize(lifts, hyperbolic)?;
+                let j = match here.take() {
+                    Some(j) => j,
+                    None => analysis.jacobian(lifts, hyperbolic)?,
+                };
+                let lu = analysis.factorize(j, lifts.home.len())?;
                 let step = newton_step(&lu, lifts.home.len(), hyperbolic, &f)?;
                 (lu, step, true)
             }
@@ -220,12 +231,14 @@ pub(crate) fn solve(
         }
         if accepted {
             factor = Some(lu);
+            here = None;
         } else {
             // No decrease along this step: with an earlier Jacobian, factor the current one;
             // with the current one, move the map by a few sweeps first.
             lifts.home = start;
             drift = start_drift;
             if fresh {
+                here = None;
                 report.sweeps += lifts.relax(hyperbolic, RESCUE_SWEEPS, 0.0);
                 f = residuals(lifts, hyperbolic, drift);
             }
@@ -334,14 +347,18 @@ impl Analysis {
             .map_err(|e| failed(format!("{e:?}")))
     }
 
-    /// The sparse LU of the Jacobian at the map `lifts`.
-    fn factorize(&self, lifts: &Lifts, hyperbolic: bool) -> Result<Lu<usize, f64>, EmbeddingError> {
+    /// The sparse LU of `a`, a Jacobian of this pattern ([`Analysis::jacobian`]) of a map of
+    /// `vertices` vertices (consumed: the LU is the map's peak of memory).
+    fn factorize(
+        &self,
+        a: SparseColMat<usize, f64>,
+        vertices: usize,
+    ) -> Result<Lu<usize, f64>, EmbeddingError> {
         let started = std::time::Instant::now();
-        let a = self.jacobian(lifts, hyperbolic)?;
         let lu = Lu::try_new_with_symbolic(self.symbolic.clone(), a.as_ref())
             .map_err(|e| failed(format!("{e:?}")))?;
         tracing::debug!(
-            vertices = lifts.home.len(),
+            vertices,
             seconds = started.elapsed().as_secs_f64(),
             "map's Jacobian factored"
         );
@@ -474,7 +491,7 @@ fn newton_step(
     )
 }
 
-/// The Newton step at the current map solved by GMRES to the relative residual `forcing` (or to
+/// The Newton step at the current map (whose Jacobian is `j`) solved by GMRES to the relative residual `forcing` (or to
 /// half the map's `tolerance`, whichever is looser), preconditioned by `earlier`: a factored Jacobian of a
 /// nearby map (a step before, or the round before). `None` where it does not converge in
 /// [`KRYLOV_ITERATIONS`].
@@ -485,18 +502,17 @@ fn newton_step(
 /// Preconditioned by the same factor, GMRES gets Newton's step to η in a few iterations: `ntori
 /// new`'s map (both rounds) genus 10 2.9 → 2.7 s, genus 32 21.9 → 15.1 s.
 fn krylov_step(
+    j: &SparseColMat<usize, f64>,
     lifts: &Lifts,
     hyperbolic: bool,
-    analysis: &Analysis,
     earlier: &Lu<usize, f64>,
     f: &[Complex64],
     forcing: f64,
     tolerance: f64,
-) -> Result<Option<(Vec<Complex64>, Complex64)>, EmbeddingError> {
+) -> Option<(Vec<Complex64>, Complex64)> {
     let started = std::time::Instant::now();
     let n = lifts.home.len();
     let size = system_size(n, hyperbolic);
-    let j = analysis.jacobian(lifts, hyperbolic)?;
     let rhs = negated(f, size);
     let threshold = (forcing * rhs.norm_l2()).max(tolerance / 2.0);
     let solved = gmres(j.as_ref(), earlier, &rhs, threshold, KRYLOV_ITERATIONS);
@@ -508,7 +524,7 @@ fn krylov_step(
     );
     // A step that is not finite is no step: the caller factors the current Jacobian instead (and
     // that one reports a singular Jacobian).
-    Ok(solved.and_then(|(x, _)| unpack(&x, n, hyperbolic).ok()))
+    solved.and_then(|(x, _)| unpack(&x, n, hyperbolic).ok())
 }
 
 /// GMRES without restarts, preconditioned on the right by the factored `m`: x with

@@ -11,6 +11,9 @@ use crate::EmbeddingError;
 /// The ridge ε where AᵀA is singular: the system is solved as AᵀA + ε² I.
 const EPSILON: f64 = 1e-6;
 
+/// ε², what a singular AᵀA gets on its diagonal (both where it is analysed here and ahead).
+const RIDGE: f64 = EPSILON * EPSILON;
+
 /// A least-squares system A x ≈ rhs, its normal equations factored.
 pub(crate) struct LeastSquares {
     a: SparseColMat<usize, f64>,
@@ -197,14 +200,13 @@ fn factor_anew(
     if let Ok(factor) = gram.sp_cholesky(faer::Side::Lower) {
         return Ok((factor, 0.0));
     }
-    let ridge = EPSILON * EPSILON;
-    let diagonal: Vec<_> = (0..cols).map(|c| Triplet::new(c, c, ridge)).collect();
+    let diagonal: Vec<_> = (0..cols).map(|c| Triplet::new(c, c, RIDGE)).collect();
     let shift = SparseColMat::<usize, f64>::try_new_from_triplets(cols, cols, &diagonal)
         .map_err(|e| failed(rows, cols, e))?;
     let factor = (gram.as_ref() + shift.as_ref())
         .sp_cholesky(faer::Side::Lower)
         .map_err(|e| failed(rows, cols, e))?;
-    Ok((factor, ridge))
+    Ok((factor, RIDGE))
 }
 
 /// `ridge` added to every diagonal entry of `m` (whose pattern holds the whole diagonal).
@@ -326,9 +328,8 @@ impl LeastSquares {
                 match llt(&spread) {
                     Ok(factor) => (factor, 0.0),
                     Err(_) => {
-                        let ridge = EPSILON * EPSILON;
-                        add_to_diagonal(&mut spread, ridge);
-                        (llt(&spread).map_err(|e| failed(rows, cols, e))?, ridge)
+                        add_to_diagonal(&mut spread, RIDGE);
+                        (llt(&spread).map_err(|e| failed(rows, cols, e))?, RIDGE)
                     }
                 }
             }
