@@ -262,6 +262,12 @@ pub struct FitSettings {
     /// derivatives times the patches' difference draw ridges of curvature along the fringe.
     /// `new`'s plates take it from genus [`PLATE_AGREEMENT_FROM`] ([`FitSettings::for_plate`]).
     pub agreement: f64,
+    /// Weight of `new`'s plates' edge samples ([`HoledMesh::edge_samples`], one point of the
+    /// intended surface between the ends of each edge) as fit targets besides the vertices (0:
+    /// none; 1: a third of the data's weight). Where a chart's cells are finer than the input's
+    /// spacing, the vertices alone leave its patch free to ripple between them, which the mean
+    /// curvature draws as hairlines. `new`'s plates take [`plate_edge_samples`].
+    pub edge_samples: f64,
 }
 
 impl Default for FitSettings {
@@ -276,6 +282,7 @@ impl Default for FitSettings {
             metric_coarsening: 1,
             raise_smoothness: false,
             agreement: 0.0,
+            edge_samples: 0.0,
         }
     }
 }
@@ -291,6 +298,8 @@ pub struct InitialFit {
     pub max_residual: f64,
     /// The input mesh's bounding-box diagonal (the model's size).
     pub mesh_diagonal: f64,
+    /// The edge samples the fit also targeted ([`FitSettings::edge_samples`]; 0 where none).
+    pub edge_samples: usize,
 }
 
 /// Peak memory of `ntori new` per input triangle (release): 1.29 GB for genus 2's 169 556
@@ -629,7 +638,10 @@ pub fn default_smoothness(grid: usize) -> f64 {
 /// chosen: [`PLATE_SMOOTHNESS`] on grids finer than 32 from genus 2 to
 /// [`PLATE_SMOOTHNESS_UP_TO`], [`default_smoothness`] otherwise (the sphere and the torus too).
 pub fn default_plate_smoothness(genus: u32, grid: usize) -> f64 {
-    if (2..=PLATE_SMOOTHNESS_UP_TO).contains(&genus) && grid > SplineSettings::default().grid {
+    if HIGH_GRID_GENERA.contains(&genus) && grid >= HIGH_GRID {
+        HIGH_GRID_SMOOTHNESS
+    } else if (2..=PLATE_SMOOTHNESS_UP_TO).contains(&genus) && grid > SplineSettings::default().grid
+    {
         PLATE_SMOOTHNESS
     } else {
         default_smoothness(grid)
@@ -705,6 +717,14 @@ pub const PLATE_SMOOTHNESS_UP_TO: u32 = 40;
 /// quadrature's points too, rose from genus 10 on, which kept 2e-3 until their rims were sampled
 /// finer ([`PLATE_SMOOTHNESS_UP_TO`]).
 pub const PLATE_SMOOTHNESS: f64 = 1e-2;
+
+/// The smoothness weight of [`HIGH_GRID_GENERA`] on their grid of [`HIGH_GRID`] or finer: about
+/// [`PLATE_SMOOTHNESS`] × (64 / 48)⁴, the same bending per unit of the chart as on 48 (the
+/// grids' second differences shrink as the grid step squared). Genus 30 and 32 with their edge
+/// samples (largest |κ| against the input's; points of the top face above 0.05 in |H| ×
+/// half-thickness, of about two million): 1.67× and 1.81× at 1e-2 (348 and 1487 points), 1.33×
+/// and 1.44× at 3e-2 (843 and 2381).
+pub const HIGH_GRID_SMOOTHNESS: f64 = 3e-2;
 
 /// `ntori new`'s spline and fit settings for `genus` where none are chosen: the default degree and
 /// continuity, [`default_grid`], [`default_disk_grid`], and that grid's fit settings
@@ -789,6 +809,7 @@ impl FitSettings {
         FitSettings {
             smoothness: default_plate_smoothness(genus, spline.grid),
             agreement: plate_agreement(genus, spline),
+            edge_samples: plate_edge_samples(genus),
             ..FitSettings::default()
         }
         .plate_smoothness(genus, spline.grid)
@@ -803,6 +824,62 @@ impl FitSettings {
             metric_coarsening: PLATE_METRIC_COARSENING,
             ..self
         }
+    }
+}
+
+/// The genera whose plate's fit targets its edge samples ([`plate_edge_samples`]).
+///
+/// From genus 17 the edge charts' cells on the flat faces (0.04–0.10 model units at genus 24)
+/// are as fine as the input's spacing there or finer (about 0.1), so between the vertices their
+/// patches were held only by the smoothness term, and rippled: thin red and blue hairlines in a
+/// mean-curvature picture (genus 32's gallery), with |H| × half-thickness up to 0.6–0.8 though
+/// the 90th percentile at the vertices read under 0.01. The edge samples put three more targets
+/// per vertex on the intended surface. Measured with `ntori new` (largest |κ| against the input's)
+/// and, over a t = 128 tessellation's points on the top face at least 0.05 inside its flat part
+/// (about two million from genus 17), |H| × half-thickness at the 99.9th percentile and how many
+/// points exceed 0.05; time and peak memory of the whole `new`, before → after (the rims eased
+/// from genus 22 before, smooth after, [`crate::holed::SMOOTH_RIMS_UP_TO`]):
+///
+/// | genus | \|κ\| | 99.9% | > 0.05 | time | memory |
+/// |---|---|---|---|---|---|
+/// | 17 | 1.29× → 1.43× | 0.104 → 0.030 | 10 719 → 77 | 24.5 → 26.2 s | 2.7 → 4.0 GB |
+/// | 20 | 1.27× → 1.33× | 0.103 → 0.030 | 11 559 → 215 | 31.2 → 32.3 s | 3.2 → 4.6 GB |
+/// | 22 | 1.28× → 1.27× | 0.190 → 0.035 | 29 467 → 587 | 33.7 → 36.9 s | 3.5 → 4.9 GB |
+/// | 24 | 1.27× → 1.31× | 0.189 → 0.037 | 32 537 → 682 | 36.2 → 47.1 s | 3.6 → 5.2 GB |
+/// | 26 | 1.30× → 1.35× | 0.182 → 0.050 | 36 197 → 3 206 | 43.6 → 46.1 s | 3.8 → 5.6 GB |
+/// | 28 | 1.43× → 1.47× | 0.217 → 0.050 | 47 514 → 3 334 | 47.5 → 53.1 s | 3.6 → 5.5 GB |
+/// | 30 | 1.27× → 1.33× | 0.212 → 0.036 | 45 206 → 843 | 59.8 → 70.1 s | 6.5 → 8.8 GB |
+/// | 32 | 1.47× → 1.44× | 0.24 → 0.044 | 56 866 → 2 381 | 54.9 → 87 s | 6.4 → 8.9 GB |
+///
+/// (30 and 32 with [`HIGH_GRID_SMOOTHNESS`].) The points between the input's vertices weigh in
+/// with more than a third of the fit's memory. Tried and left:
+/// - weight 1 or 0.5 instead of 2 (genus 32, smooth rims, λ 1e-2: 1.66× and 1889 points, 1.52×
+///   and 2991, against 1.81× and 1487); weight 4 on the flat faces alone at 24 read 3408;
+/// - samples on the flat faces only: the rims' curvature peaks rose (genus 24 2.39×, 32 5.11×);
+///   on the flat faces only 0.15 or more from the rims, the hairlines stayed (24: 16 887);
+/// - with the rims eased as before, the peaks rose at the rims' start in the edge charts (24
+///   1.43×, 32 2.37×); smooth rims without samples left the hairlines (24: 17 121, 32: 38 389);
+/// - the samples at the middle of their ends' chart coordinates rather than the geodesic
+///   midpoint: along the faces up to 0.027 model units from where the fit put them (0.015 at the
+///   geodesic midpoint), the vertices' residual 0.035% of the diagonal against 0.019%;
+/// - centroids of the flat faces' triangles as well (genus 24: 7832 → 6037 points, 1.37× → 1.40×).
+///
+/// Genus 5 to 16 have hairlines of another kind, fewer and fainter, along the vertex chart's
+/// coarse rim cells ([`FINE_DISK_GENERA`]): there the samples helped less (16: 4474 → 2650, 1.17×
+/// → 1.26×, 1.3 GB more).
+pub const PLATE_EDGE_SAMPLE_GENERA: std::ops::RangeInclusive<u32> = 17..=32;
+
+/// The edge samples' weight ([`FitSettings::edge_samples`]) for `new`'s plates: together they
+/// weigh as much as the vertices (see [`PLATE_EDGE_SAMPLE_GENERA`] for 1 and 0.5).
+pub const PLATE_EDGE_SAMPLE_WEIGHT: f64 = 2.0;
+
+/// [`FitSettings::edge_samples`] for `ntori new`'s plate of `genus`: [`PLATE_EDGE_SAMPLE_WEIGHT`]
+/// for [`PLATE_EDGE_SAMPLE_GENERA`], none otherwise.
+pub fn plate_edge_samples(genus: u32) -> f64 {
+    if PLATE_EDGE_SAMPLE_GENERA.contains(&genus) {
+        PLATE_EDGE_SAMPLE_WEIGHT
+    } else {
+        0.0
     }
 }
 
@@ -980,13 +1057,27 @@ pub fn initial_model_with_progress(
     };
     progress(FitStage::Fitting);
     let weights = vertex_areas(&mesh.positions, &mesh.triangles);
-    let control = fit(
-        &layout,
-        &parameterization.points,
-        &mesh.positions,
-        &weights,
-        fit_settings,
-    )?;
+    let samples = match fit_settings.edge_samples {
+        w if w > 0.0 => edge_samples(&atlas, &mesh, &parameterization, &weights, w)?,
+        _ => Samples::default(),
+    };
+    let control = if samples.points.is_empty() {
+        fit(
+            &layout,
+            &parameterization.points,
+            &mesh.positions,
+            &weights,
+            fit_settings,
+        )?
+    } else {
+        fit(
+            &layout,
+            &[parameterization.points.as_slice(), &samples.points].concat(),
+            &[mesh.positions.as_slice(), &samples.targets].concat(),
+            &[weights.as_slice(), &samples.weights].concat(),
+            fit_settings,
+        )?
+    };
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (p, target) in parameterization.points.iter().zip(&mesh.positions) {
         let e = (layout.eval(&control, *p).pos - target).norm();
@@ -999,9 +1090,91 @@ pub fn initial_model_with_progress(
         rms_residual: (sum / mesh.positions.len() as f64).sqrt(),
         max_residual: max,
         mesh_diagonal: diagonal(&mesh.positions),
+        edge_samples: samples.points.len(),
         mesh,
         parameterization,
     })
+}
+
+/// Fit targets besides the mesh's vertices: where they lie in the charts, where in space, and how
+/// much each weighs (in the units of [`vertex_areas`]).
+#[derive(Default)]
+struct Samples {
+    points: Vec<ChartPoint>,
+    targets: Vec<Point3>,
+    weights: Vec<f64>,
+}
+
+/// The plate's [`HoledMesh::edge_samples`] as fit targets, each at the hyperbolic (on the torus,
+/// Euclidean) midpoint of its edge's ends in the map, weighing `weight` times a sixth of the mean
+/// of its ends' [`vertex_areas`] (on an even mesh, a third of a triangle each way: 1 makes the
+/// samples a third of the data's weight). The geodesic midpoint does not depend on the chart, as
+/// the midpoint of chart coordinates does: at genus 24 that one lay up to 0.027 model units along
+/// the face from where the fit put the edge's midpoint, against 0.015 for the geodesic one. The
+/// sphere, mapped without a cut, has none.
+fn edge_samples(
+    atlas: &Atlas,
+    mesh: &HoledMesh,
+    parameterization: &Parameterization,
+    areas: &[f64],
+    weight: f64,
+) -> Result<Samples, EmbeddingError> {
+    let Some(disk) = &parameterization.disk else {
+        return Ok(Samples::default());
+    };
+    let hyperbolic = atlas
+        .polygon()
+        .is_some_and(|p| p.geometry() == Geometry::Hyperbolic);
+    // Each mesh edge's ends as disk copies of one triangle, so their positions lie in one frame.
+    let mut copies = HashMap::with_capacity(3 * disk.triangles.len());
+    for t in &disk.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            copies.insert(
+                (disk.original[a as usize], disk.original[b as usize]),
+                (a, b),
+            );
+        }
+    }
+    let mut samples = Samples::default();
+    for e in &mesh.edge_samples {
+        let [a, b] = e.ends;
+        let Some(&(ca, cb)) = copies.get(&(a, b)).or_else(|| copies.get(&(b, a))) else {
+            return Err(EmbeddingError::Parameterization(format!(
+                "the edge sample between vertices {a} and {b} has no edge in the cut disk"
+            )));
+        };
+        let (p, q) = (
+            parameterization.copies[ca as usize],
+            parameterization.copies[cb as usize],
+        );
+        let middle = if hyperbolic {
+            geodesic_midpoint(p, q)
+        } else {
+            0.5 * (p + q)
+        };
+        samples.points.push(deepest(atlas, ModelPoint(middle))?);
+        samples.targets.push(e.position);
+        samples
+            .weights
+            .push(weight * (areas[a as usize] + areas[b as usize]) / 12.0);
+    }
+    Ok(samples)
+}
+
+/// The midpoint of the hyperbolic segment from `p` to `q` in the Poincaré disk: the isometry
+/// taking `p` to 0 takes the segment onto a radius, whose midpoint halves the distance
+/// 2 artanh |q′|.
+fn geodesic_midpoint(p: Complex64, q: Complex64) -> Complex64 {
+    let one = Complex64::new(1.0, 0.0);
+    let q1 = (q - p) / (one - p.conj() * q);
+    let r = q1.norm();
+    let m1 = if r > 0.0 {
+        q1 * ((0.5 * r.atanh()).tanh() / r)
+    } else {
+        q1
+    };
+    (m1 + p) / (one + p.conj() * m1)
 }
 
 /// The bounding-box diagonal of a point set.
@@ -2236,6 +2409,76 @@ pub(crate) fn smoothness_rows_at(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// The hyperbolic distance between two points of the Poincaré disk.
+    fn distance(p: Complex64, q: Complex64) -> f64 {
+        2.0 * ((q - p) / (Complex64::new(1.0, 0.0) - p.conj() * q))
+            .norm()
+            .atanh()
+    }
+
+    proptest! {
+        /// The geodesic midpoint halves the distance and lies on the segment (the two halves add
+        /// up to the whole), anywhere in the disk, however far apart the ends.
+        #[test]
+        fn the_geodesic_midpoint_halves_the_segment(
+            r1 in 0.0f64..0.99, a1 in 0.0f64..std::f64::consts::TAU,
+            r2 in 0.0f64..0.99, a2 in 0.0f64..std::f64::consts::TAU,
+        ) {
+            let (p, q) = (Complex64::from_polar(r1, a1), Complex64::from_polar(r2, a2));
+            let m = geodesic_midpoint(p, q);
+            let (whole, first, second) = (distance(p, q), distance(p, m), distance(m, q));
+            prop_assert!(m.norm() < 1.0);
+            prop_assert!((first - second).abs() < 1e-9 * (1.0 + whole), "{first} {second}");
+            prop_assert!((first + second - whole).abs() < 1e-9 * (1.0 + whole), "{first} + {second} ≠ {whole}");
+        }
+    }
+
+    /// A plate fitted to its edge samples too lies closer to the intended surface between its
+    /// vertices than one fitted to the vertices alone (the same mesh and map); `InitialFit`
+    /// counts the samples.
+    #[test]
+    fn edge_samples_bring_the_fit_closer_between_the_vertices() {
+        let spline = SplineSettings::default();
+        let plain = FitSettings::for_grid(spline.grid);
+        let sampled = FitSettings {
+            edge_samples: PLATE_EDGE_SAMPLE_WEIGHT,
+            ..plain
+        };
+        let [without, with] = [plain, sampled].map(|s| initial_model(3, 12, spline, s).unwrap());
+        assert_eq!(
+            (without.edge_samples, with.edge_samples),
+            (0, with.mesh.edge_samples.len())
+        );
+        let between = |fit: &InitialFit| {
+            let areas = vertex_areas(&fit.mesh.positions, &fit.mesh.triangles);
+            let atlas = fit.surface.atlas();
+            let samples =
+                edge_samples(atlas, &fit.mesh, &fit.parameterization, &areas, 1.0).unwrap();
+            let layout = fit.surface.layout();
+            let off: Vec<f64> = samples
+                .points
+                .iter()
+                .zip(&samples.targets)
+                .map(|(p, t)| (layout.eval(fit.surface.control_points(), *p).pos - t).norm())
+                .collect();
+            (
+                off.iter().sum::<f64>() / off.len() as f64,
+                off.iter().copied().fold(0.0, f64::max),
+            )
+        };
+        let (before, after) = (between(&without), between(&with));
+        eprintln!(
+            "between the vertices (mean, max): {before:?} → {after:?}; at them {} → {}",
+            without.max_residual, with.max_residual
+        );
+        // The vertices give a little for it (0.0046 → 0.0135 model units at most, where the
+        // map's midpoint and the fit's disagree along the surface); the worst over both halves.
+        assert!(after.0 < 0.5 * before.0, "{before:?} → {after:?}");
+        let worst = |fit: &InitialFit, between: (f64, f64)| fit.max_residual.max(between.1);
+        assert!(worst(&with, after) < 0.5 * worst(&without, before));
+    }
 
     /// The analysis the fit makes ahead from the data rows and the smoothness stencils holds
     /// the whole system's AᵀA, with the plain rows and with the arc-length rows, on the plates

@@ -279,6 +279,7 @@ fn as_fitted<'a>(
         settings,
         smoothness: fit.smoothness.used,
         agreement,
+        edge_samples: 0,
     }
 }
 

@@ -67,6 +67,12 @@ pub struct Args {
     /// genus 64; the rims are sampled twice as finely across up to genus 40].
     #[arg(long, value_name = "R", value_parser = clap::value_parser!(u64).range(8..=1024))]
     resolution: Option<u64>,
+    /// Weight of the mesh's edge samples as fit targets besides its vertices: one point of the
+    /// intended surface between the ends of each edge (0: none; 1: half the vertices' weight)
+    /// [default: 2 for genus 17 to 32, whose edge charts' cells are as fine as the mesh's
+    /// spacing and rippled between its vertices; 0 otherwise]
+    #[arg(long, value_name = "W", value_parser = parse_edge_samples)]
+    edge_samples: Option<f64>,
     #[command(flatten)]
     spline: FitArgs,
     /// Print the report as JSON.
@@ -77,6 +83,21 @@ pub struct Args {
     quiet: bool,
 }
 
+/// The largest `--edge-samples` weight: a thousand times the vertices' (beyond it the fit hardly
+/// sees them).
+const MAX_EDGE_SAMPLES: f64 = 1e3;
+
+fn parse_edge_samples(s: &str) -> Result<f64, String> {
+    let v = super::parse_number(s)?;
+    if v.is_finite() && (0.0..=MAX_EDGE_SAMPLES).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "the edge samples' weight must lie in [0, {MAX_EDGE_SAMPLES:e}], got {v}"
+        ))
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Args {
         genus: GenusArg { genus },
@@ -85,6 +106,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         keep_failed,
         input_mesh,
         resolution,
+        edge_samples,
         spline,
         json,
         quiet,
@@ -96,7 +118,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         |grid| embedding::fit::default_plate_smoothness(genus, grid),
         |spline| embedding::fit::plate_agreement(genus, spline),
     )?;
-    let fit = fit.plate_smoothness(genus, settings.grid);
+    let fit = FitSettings {
+        edge_samples: edge_samples.unwrap_or_else(|| embedding::fit::plate_edge_samples(genus)),
+        ..fit.plate_smoothness(genus, settings.grid)
+    };
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
     let target = ntori::io::atomic::check_output(&output, &[])?;
@@ -199,6 +224,9 @@ pub struct NewReport {
     /// The agreement rows' weight (`FitSettings::agreement`; 0: none).
     pub agreement: f64,
     pub mesh_vertices: usize,
+    /// Points of the intended surface between the input's vertices that the fit also targeted
+    /// (`embedding::holed::HoledMesh::edge_samples`; 0: none).
+    pub edge_samples: usize,
     pub mesh_triangles: usize,
     pub control_points: usize,
     /// Gauss–Seidel sweeps of the parameterization (the sphere's whole relaxation, or the polygon
@@ -474,6 +502,8 @@ pub struct Fitted<'a> {
     pub settings: SplineSettings,
     pub smoothness: f64,
     pub agreement: f64,
+    /// Points between the input's vertices the fit also targeted (`FitSettings::edge_samples`).
+    pub edge_samples: usize,
 }
 
 /// A plate's flat faces: the input's vertices on them (`embedding::holed::HoledMesh::flat_vertices`)
@@ -505,6 +535,7 @@ pub fn check(
         settings,
         smoothness,
         agreement,
+        edge_samples,
     } = *fitted;
     stage("integrating the curvature");
     let layout = surface.layout();
@@ -525,6 +556,7 @@ pub fn check(
         smoothness,
         agreement,
         mesh_vertices: positions.len(),
+        edge_samples,
         mesh_triangles: triangles.len(),
         control_points: surface.control_points().len(),
         sweeps: parameterization.sweeps,
@@ -574,6 +606,7 @@ pub fn make(
         rms_residual,
         max_residual,
         mesh_diagonal,
+        edge_samples,
     } = initial_model_with_progress(genus, resolution, settings, fit, &|s| progress.fit_stage(s))?;
     let flat_vertices = mesh.flat_vertices();
     let checked = Fitted {
@@ -593,6 +626,7 @@ pub fn make(
         settings,
         smoothness: fit.smoothness,
         agreement: fit.agreement,
+        edge_samples,
     };
     let report = check(&checked, start, &|s| progress.stage(s))?;
     Ok(Made {
@@ -675,7 +709,7 @@ impl NewReport {
         format!(
             "genus {genus}: degree {degree}, C^{cont} blends, {grid}, \
              {controls} control points\n\
-             input mesh: {v} vertices, {f} triangles, bounding-box diagonal {diag:.3}\n\
+             input mesh: {v} vertices, {f} triangles, bounding-box diagonal {diag:.3}{samples}\n\
              parameterization: {solve}, {folded} folded triangles ({bij}){distortion}\n\
              fit residual: rms {rms:.3}%, max {max:.3}% of the diagonal ({res})\n\
              distance: surface and input mesh within {dist:.3}% of the diagonal of each other \
@@ -692,6 +726,10 @@ impl NewReport {
             grid = self.settings.grid_text(),
             controls = self.control_points,
             v = self.mesh_vertices,
+            samples = match self.edge_samples {
+                0 => String::new(),
+                n => format!("; the fit also targets {n} points between the vertices"),
+            },
             f = self.mesh_triangles,
             diag = self.diagonal,
             solve = self.solve_text(),
