@@ -2,7 +2,8 @@
 //!
 //! - `initial_fit`: `ntori new`'s pipeline (mesh, cut, Floater, relaxation, least squares) for
 //!   genus 2, 5 and 10 at `ntori new`'s resolution, grid and smoothness (genus 5 and 10:
-//!   resolution 40), and with `--bench` genus 32 too (about 46 s a fit here, 6.4 GB, on its 377 252 triangles and grid of 64; issue 12's targets: 1 s, 5 s and
+//!   resolution 40), and with `--bench` genus 32 too (about 46 s a fit here, 6.4 GB, on its 377 252 triangles and grid of 64, before its edge
+//!   samples; with them `ntori new -v`'s stages up to the fit add up to 55 s against 39 s, 9.1 GB; issue 12's targets: 1 s, 5 s and
 //!   60 s for genus 2, 10 and 32). The map dominates: its sweeps and Newton steps are reported by
 //!   `ntori new`.
 //! - `mesh_fit`: `ntori fit`'s pipeline (greedy loops from several base vertices, the canonical

@@ -472,8 +472,8 @@ pub fn default_grid(genus: u32) -> usize {
 }
 
 /// The genera whose control points are moved from the edge charts to the disk charts: their
-/// edge charts take [`FINE_DISK_EDGE_GRID`] ([`default_grid`]) and their disk charts three or
-/// four times that ([`default_disk_grid`]).
+/// edge charts take [`FINE_DISK_EDGE_GRID`] ([`default_grid`]) and their disk charts three to
+/// five times that ([`default_disk_grid`]).
 ///
 /// From genus 5 the vertex chart carries the flat faces' strips between the holes and the outer
 /// rim near its own rim, where its Poincaré coordinates stretch: a cell there spanned 0.21–0.31
@@ -544,8 +544,9 @@ pub const HIGH_GRID: usize = 64;
 
 /// The disk charts' grid `ntori new` uses for `genus` and an edge-chart `grid` where none is
 /// chosen (`None`: the same as the edge charts'): twice `grid` at genus 3 and 4 (96 at their 48),
-/// three times from genus 5 and four times from 11 (120 and 160 at [`FINE_DISK_EDGE_GRID`], see
-/// [`FINE_DISK_GENERA`]), 16/3 from genus 17 and 8 times from genus 34 (256 and 384 at 48),
+/// three times from genus 5, four times from 11 and five times at 16 (120, 160 and 200 at
+/// [`FINE_DISK_EDGE_GRID`], see [`FINE_DISK_GENERA`]; genus 16 with its edge samples, see
+/// [`PLATE_EDGE_SAMPLE_GENERA`]), 16/3 from genus 17 and 8 times from genus 34 (256 and 384 at 48),
 /// rounded up to a multiple of 8. (Genus 16 took 8/3 of 48, 128, before [`FINE_DISK_GENERA`].)
 ///
 /// The inside and vertex charts are each a disk about a point whose hyperbolic neighbourhood
@@ -612,7 +613,8 @@ pub fn default_disk_grid(genus: u32, grid: usize) -> Option<usize> {
         0..=2 => return None,
         3..=4 => (2, 1),
         5..=10 => (3, 1),
-        11..=16 => (4, 1),
+        11..=15 => (4, 1),
+        16 => (5, 1),
         17..=33 => (16, 3),
         _ => (8, 1),
     };
@@ -636,10 +638,11 @@ pub fn default_smoothness(grid: usize) -> f64 {
 
 /// The smoothness weight λ for `ntori new`'s plate of `genus` on a grid of `grid` where none is
 /// chosen: [`PLATE_SMOOTHNESS`] on grids finer than 32 from genus 2 to
-/// [`PLATE_SMOOTHNESS_UP_TO`], [`default_smoothness`] otherwise (the sphere and the torus too).
+/// [`PLATE_SMOOTHNESS_UP_TO`] ([`STIFF_PLATE_SMOOTHNESS`] for [`STIFF_PLATE_GENERA`]),
+/// [`default_smoothness`] otherwise (the sphere and the torus too).
 pub fn default_plate_smoothness(genus: u32, grid: usize) -> f64 {
-    if HIGH_GRID_GENERA.contains(&genus) && grid >= HIGH_GRID {
-        HIGH_GRID_SMOOTHNESS
+    if STIFF_PLATE_GENERA.contains(&genus) && grid > SplineSettings::default().grid {
+        STIFF_PLATE_SMOOTHNESS
     } else if (2..=PLATE_SMOOTHNESS_UP_TO).contains(&genus) && grid > SplineSettings::default().grid
     {
         PLATE_SMOOTHNESS
@@ -718,13 +721,27 @@ pub const PLATE_SMOOTHNESS_UP_TO: u32 = 40;
 /// finer ([`PLATE_SMOOTHNESS_UP_TO`]).
 pub const PLATE_SMOOTHNESS: f64 = 1e-2;
 
-/// The smoothness weight of [`HIGH_GRID_GENERA`] on their grid of [`HIGH_GRID`] or finer: about
-/// [`PLATE_SMOOTHNESS`] × (64 / 48)⁴, the same bending per unit of the chart as on 48 (the
-/// grids' second differences shrink as the grid step squared). Genus 30 and 32 with their edge
-/// samples (largest |κ| against the input's; points of the top face above 0.05 in |H| ×
-/// half-thickness, of about two million): 1.67× and 1.81× at 1e-2 (348 and 1487 points), 1.33×
-/// and 1.44× at 3e-2 (843 and 2381).
-pub const HIGH_GRID_SMOOTHNESS: f64 = 3e-2;
+/// The genera whose plates take [`STIFF_PLATE_SMOOTHNESS`] on grids finer than 32.
+///
+/// With their edge samples ([`PLATE_EDGE_SAMPLE_GENERA`]) the fit follows the rims more closely,
+/// and from genus 27 its peaks of |κ| at the rims' start rose past issue 12's 1.5×. Measured with
+/// `ntori new` (largest |κ| against the input's; points of the top face above 0.05 in |H| ×
+/// half-thickness, of about two million, as in [`PLATE_EDGE_SAMPLE_GENERA`]), λ = 1e-2 → 3e-2:
+///
+/// | genus | 17 | 20 | 22 | 24 | 26 | 27 | 28 | 29 | 30 | 32 |
+/// |---|---|---|---|---|---|---|---|---|---|---|
+/// | \|κ\| | 1.43× → 1.21× | 1.33× → 1.19× | 1.27× → 1.29× | 1.31× → 1.36× | 1.35× → 1.39× | 1.51× → 1.47× | 1.47× → 1.37× | 1.54× → 1.35× | 1.67× → 1.33× | 1.81× → 1.44× |
+/// | > 0.05 | 77 → 288 | 215 → 660 | 587 → 837 | 682 → 2072 | 3206 → 6634 | 3749 → 7715 | 3334 → 6943 | 3618 → 8077 | 348 → 843 | 1487 → 2381 |
+///
+/// The stronger weight costs hairlines everywhere, so it is kept where the peaks need it. Genus 31
+/// still reads 1.59× at 3e-2 (1.52× at 1e-1, 1.61× with the samples at weight 1, 1.80× without
+/// them; 1.49× before, with eased rims and no samples). (30 to 32 have a grid of 64, whose second
+/// differences are (48/64)² of 48's for the same bending: at the same λ they are smoothed a third
+/// as much.)
+pub const STIFF_PLATE_GENERA: std::ops::RangeInclusive<u32> = 27..=32;
+
+/// The plates' smoothness weight for [`STIFF_PLATE_GENERA`], three times [`PLATE_SMOOTHNESS`].
+pub const STIFF_PLATE_SMOOTHNESS: f64 = 3e-2;
 
 /// `ntori new`'s spline and fit settings for `genus` where none are chosen: the default degree and
 /// continuity, [`default_grid`], [`default_disk_grid`], and that grid's fit settings
@@ -847,12 +864,14 @@ impl FitSettings {
 /// | 22 | 1.28× → 1.27× | 0.190 → 0.035 | 29 467 → 587 | 33.7 → 36.9 s | 3.5 → 4.9 GB |
 /// | 24 | 1.27× → 1.31× | 0.189 → 0.037 | 32 537 → 682 | 36.2 → 47.1 s | 3.6 → 5.2 GB |
 /// | 26 | 1.30× → 1.35× | 0.182 → 0.050 | 36 197 → 3 206 | 43.6 → 46.1 s | 3.8 → 5.6 GB |
-/// | 28 | 1.43× → 1.47× | 0.217 → 0.050 | 47 514 → 3 334 | 47.5 → 53.1 s | 3.6 → 5.5 GB |
+/// | 28 | 1.43× → 1.37× | 0.217 → 0.065 | 47 514 → 6 943 | 47.5 → 47.0 s | 3.6 → 5.5 GB |
 /// | 30 | 1.27× → 1.33× | 0.212 → 0.036 | 45 206 → 843 | 59.8 → 70.1 s | 6.5 → 8.8 GB |
-/// | 32 | 1.47× → 1.44× | 0.24 → 0.044 | 56 866 → 2 381 | 54.9 → 87 s | 6.4 → 8.9 GB |
+/// | 32 | 1.47× → 1.44× | 0.24 → 0.044 | 56 866 → 2 381 | 54.9 → 76.2 s | 6.4 → 9.1 GB |
 ///
-/// (30 and 32 with [`HIGH_GRID_SMOOTHNESS`].) The points between the input's vertices weigh in
-/// with more than a third of the fit's memory. Tried and left:
+/// (28 to 32 with [`STIFF_PLATE_SMOOTHNESS`]; the times from runs one after another, 32's alone.)
+/// The samples cost up to half as much memory again, and at genus 32 double the fit's own stage
+/// (15.4 → 29.4 s: A's nonzeros 20 → 46 million, AᵀA 1.4 → 6.0 s, its factorization 9.4 →
+/// 14.9 s). Tried and left:
 /// - weight 1 or 0.5 instead of 2 (genus 32, smooth rims, λ 1e-2: 1.66× and 1889 points, 1.52×
 ///   and 2991, against 1.81× and 1487); weight 4 on the flat faces alone at 24 read 3408;
 /// - samples on the flat faces only: the rims' curvature peaks rose (genus 24 2.39×, 32 5.11×);
@@ -865,9 +884,13 @@ impl FitSettings {
 /// - centroids of the flat faces' triangles as well (genus 24: 7832 → 6037 points, 1.37× → 1.40×).
 ///
 /// Genus 5 to 16 have hairlines of another kind, fewer and fainter, along the vertex chart's
-/// coarse rim cells ([`FINE_DISK_GENERA`]): there the samples helped less (16: 4474 → 2650, 1.17×
-/// → 1.26×, 1.3 GB more).
-pub const PLATE_EDGE_SAMPLE_GENERA: std::ops::RangeInclusive<u32> = 17..=32;
+/// coarse rim cells ([`FINE_DISK_GENERA`]): there the samples alone helped less (16: 4474 → 2650
+/// points, 1.17× → 1.26×, 1.3 GB more). Genus 16, in the gallery, takes them with a disk grid of
+/// 200 instead of 160: 951 points, 99.9th percentile 0.064 → 0.044, 1.15×, 24.8 → 30.4 s, 2.0 →
+/// 3.5 GB (the disk grid alone at 192 on 48: 2529 points). Left out for the samples beyond the
+/// vertices: their chart patches' own rows (genus 24: 682 → 1602 points, 1.31× → 1.35×, 0.7 GB
+/// less).
+pub const PLATE_EDGE_SAMPLE_GENERA: std::ops::RangeInclusive<u32> = 16..=32;
 
 /// The edge samples' weight ([`FitSettings::edge_samples`]) for `new`'s plates: together they
 /// weigh as much as the vertices (see [`PLATE_EDGE_SAMPLE_GENERA`] for 1 and 0.5).

@@ -17,8 +17,9 @@ use super::write_stdout;
 /// figure 7 (the tessellation), a gallery (genus 0 to 6, 8, 10, 16 and 32 shaded; genus 3, 5, 10,
 /// 16 and 32 in mean curvature; genus 2 in the chart and curvature styles; PNG), and CAPTIONS.md
 /// listing every file with what it shows and the parameters that made it. The 2D figures are for
-/// genus 2, like the paper's. The whole command takes about a minute and a half on two cores,
-/// most of it for genus 32's fit (on its grid of 64 and 377 252 triangles), and 7 GB.
+/// genus 2, like the paper's. The whole command takes about two minutes on two cores, most of it
+/// for genus 32's fit (on its grid of 64 and 377 252 triangles, and the points between them),
+/// and 10 GB.
 ///
 /// The PNG figures need a GPU (or a software adapter); without one they are left out with a
 /// warning, and the caption file says so. Running the command again writes the same bytes.

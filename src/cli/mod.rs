@@ -121,7 +121,7 @@ struct FitArgs {
     /// `fit` from genus 1 measures that energy in the surface's arc length, from a first fit)
     /// [default: 1e-4 for grids up to 32, 2e-3 for finer ones, whose second differences are
     /// smaller for the same shape, and 1e-2 for new's plates of genus 2 to 40 on those (3e-2 at genus
-    /// 30 to 32 on their grid of 64); `fit` raises
+    /// 27 to 32); `fit` raises
     /// it where that leaves the surface rough]
     #[arg(long, value_name = "λ", value_parser = parse_smoothness)]
     smoothness: Option<f64>,

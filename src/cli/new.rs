@@ -69,8 +69,8 @@ pub struct Args {
     resolution: Option<u64>,
     /// Weight of the mesh's edge samples as fit targets besides its vertices: one point of the
     /// intended surface between the ends of each edge (0: none; 1: half the vertices' weight)
-    /// [default: 2 for genus 17 to 32, whose edge charts' cells are as fine as the mesh's
-    /// spacing and rippled between its vertices; 0 otherwise]
+    /// [default: 2 for genus 16 to 32, whose charts' cells are as fine as the mesh's spacing and
+    /// rippled between its vertices; 0 otherwise]
     #[arg(long, value_name = "W", value_parser = parse_edge_samples)]
     edge_samples: Option<f64>,
     #[command(flatten)]

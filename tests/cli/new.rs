@@ -248,8 +248,10 @@ fn genus_24_passes_its_checks_within_one_and_a_half_times_the_inputs_curvature()
     let shape = &report["shape"];
     let ratio = shape["curvature_ratio"].as_f64().unwrap();
     assert!(ratio < 1.5, "{shape}");
+    // The patches agree within a quarter of issue 12's 0.2% of the diagonal (0.035%: the samples
+    // between the vertices pull them apart a little, 0.006% without).
     assert!(
-        shape["patch_disagreement"].as_f64().unwrap() < 1e-4,
+        shape["patch_disagreement"].as_f64().unwrap() < 5e-4,
         "{shape}"
     );
 }

@@ -526,14 +526,14 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
     );
     // What `new` fits with where nothing is chosen: the grid, its smoothness, the other defaults.
     // The plates' stronger weight: genus 2 to 40 on grids finer than 32, not the sphere or the
-    // torus on any grid, not genus 41 and up, not a coarse grid; genus 30 to 32 on their grid of
-    // 64 a weight stronger again, for the same bending per unit of the chart.
-    use embedding::fit::{HIGH_GRID_SMOOTHNESS, PLATE_SMOOTHNESS, default_plate_smoothness};
-    const { assert!(HIGH_GRID_SMOOTHNESS > 2.0 * PLATE_SMOOTHNESS) };
+    // torus on any grid, not genus 41 and up, not a coarse grid; genus 27 to 32, whose edge
+    // samples raised the rims' peaks, a weight stronger again.
+    use embedding::fit::{PLATE_SMOOTHNESS, STIFF_PLATE_SMOOTHNESS, default_plate_smoothness};
+    const { assert!(STIFF_PLATE_SMOOTHNESS > 2.0 * PLATE_SMOOTHNESS) };
     for genus in 0..=64 {
         for grid in [16, 32, 40, FINE_GRID, 64] {
-            let expected = if (30..=32).contains(&genus) && grid >= HIGH_GRID {
-                HIGH_GRID_SMOOTHNESS
+            let expected = if (27..=32).contains(&genus) && grid > 32 {
+                STIFF_PLATE_SMOOTHNESS
             } else if (2..=40).contains(&genus) && grid > 32 {
                 PLATE_SMOOTHNESS
             } else {
@@ -560,8 +560,8 @@ fn the_default_grid_is_32_for_the_sphere_and_torus_and_finer_above_with_more_smo
         });
         assert_eq!(fit, FitSettings::for_plate(genus, spline), "genus {genus}");
         // The plates of genus 2 to 40 take the stronger weight on their fine grids.
-        let expected = if (30..=32).contains(&genus) {
-            HIGH_GRID_SMOOTHNESS
+        let expected = if (27..=32).contains(&genus) {
+            STIFF_PLATE_SMOOTHNESS
         } else if (2..=40).contains(&genus) {
             embedding::fit::PLATE_SMOOTHNESS
         } else {
