@@ -104,7 +104,7 @@ struct FitArgs {
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
     /// the grid at genus 3 and 4 (96 at 48), three times from genus 5 (120 at 40), four times
-    /// from genus 11 (160 at 40), 16/3 from genus 17 (256 at 48) and 8 times from genus 34
+    /// from genus 11 (160 at 40), five times at 16 (200), 16/3 from genus 17 (256 at 48) and 8 times from genus 34
     /// (384), the grid below genus 3; for fit twice the grid from genus
     /// 2 (80 at 40), the grid below; the grid for fit --cage]
     #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=512))]
