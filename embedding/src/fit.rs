@@ -1084,23 +1084,13 @@ pub fn initial_model_with_progress(
         w if w > 0.0 => edge_samples(&atlas, &mesh, &parameterization, &weights, w)?,
         _ => Samples::default(),
     };
-    let control = if samples.points.is_empty() {
-        fit(
-            &layout,
-            &parameterization.points,
-            &mesh.positions,
-            &weights,
-            fit_settings,
-        )?
-    } else {
-        fit(
-            &layout,
-            &[parameterization.points.as_slice(), &samples.points].concat(),
-            &[mesh.positions.as_slice(), &samples.targets].concat(),
-            &[weights.as_slice(), &samples.weights].concat(),
-            fit_settings,
-        )?
-    };
+    let control = fit(
+        &layout,
+        &[parameterization.points.as_slice(), &samples.points].concat(),
+        &[mesh.positions.as_slice(), &samples.targets].concat(),
+        &[weights.as_slice(), &samples.weights].concat(),
+        fit_settings,
+    )?;
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (p, target) in parameterization.points.iter().zip(&mesh.positions) {
         let e = (layout.eval(&control, *p).pos - target).norm();

@@ -225,13 +225,16 @@ fn parse_smoothness(s: &str) -> Result<f64, String> {
 const MAX_AGREEMENT: f64 = 1e3;
 
 fn parse_agreement(s: &str) -> Result<f64, String> {
+    parse_weight(s, "the agreement weight", MAX_AGREEMENT)
+}
+
+/// A weight in [0, `max`] (0 turning its rows off), or why `s` is not one, naming `what`.
+fn parse_weight(s: &str, what: &str, max: f64) -> Result<f64, String> {
     let v = parse_number(s)?;
-    if v.is_finite() && (0.0..=MAX_AGREEMENT).contains(&v) {
+    if v.is_finite() && (0.0..=max).contains(&v) {
         Ok(v)
     } else {
-        Err(format!(
-            "the agreement weight must lie in [0, {MAX_AGREEMENT:e}], got {v}"
-        ))
+        Err(format!("{what} must lie in [0, {max:e}], got {v}"))
     }
 }
 

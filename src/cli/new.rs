@@ -88,14 +88,7 @@ pub struct Args {
 const MAX_EDGE_SAMPLES: f64 = 1e3;
 
 fn parse_edge_samples(s: &str) -> Result<f64, String> {
-    let v = super::parse_number(s)?;
-    if v.is_finite() && (0.0..=MAX_EDGE_SAMPLES).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!(
-            "the edge samples' weight must lie in [0, {MAX_EDGE_SAMPLES:e}], got {v}"
-        ))
-    }
+    super::parse_weight(s, "the edge samples' weight", MAX_EDGE_SAMPLES)
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
