@@ -395,6 +395,25 @@ impl PlateLayout {
             .fold(rim, f64::min)
     }
 
+    /// Whether [`PlateLayout::flat_depth`] at (x, y) exceeds `margin` (≥ 0), with one hole's
+    /// distance instead of n: the holes' centres lie on one ring, so the nearest is the one nearest
+    /// in angle, and a point farther than a hole's reach from the ring is clear of them all. The
+    /// curvature quadrature asks this at millions of points.
+    pub fn is_flat_beyond(&self, x: f64, y: f64, margin: f64) -> bool {
+        let radius = x.hypot(y);
+        if self.outer_radius - self.band - radius <= margin {
+            return false;
+        }
+        let reach = self.hole_radius + self.band + margin;
+        if (radius - self.ring).abs() > reach {
+            return true;
+        }
+        let n = f64::from(self.genus.max(1));
+        let k = (y.atan2(x) * n / TAU).round().rem_euclid(n) as u32;
+        let c = self.hole_centre(k);
+        (x - c[0]).hypot(y - c[1]) > reach
+    }
+
     /// The turn φ(t) of the rims' cross-section, t from 0 at the flat face to 1 at the circle
     /// (smooth up to genus [`SMOOTH_RIMS_UP_TO`], eased beyond).
     pub fn rim_angle(&self, t: f64) -> f64 {
@@ -1379,6 +1398,39 @@ mod tests {
             prop_assert!(moved <= plan.band * (1.0 - depth / plan.band).max(0.0) + 1e-12);
             if depth >= plan.band {
                 prop_assert!(moved == 0.0 && p.z == plan.thickness);
+            }
+        }
+
+        /// The one-hole test of the flat faces answers as the depth over every hole does, across
+        /// the whole plate and beyond it, at every genus.
+        #[test]
+        fn is_flat_beyond_is_the_depths_answer(
+            genus in 2u32..=64, u in -1.2f64..1.2, v in -1.2f64..1.2, margin in 0.0f64..0.2,
+        ) {
+            let plate = PlateLayout::new(genus);
+            let (x, y) = (u * plate.outer_radius, v * plate.outer_radius);
+            let depth = plate.flat_depth(x, y);
+            prop_assume!((depth - margin).abs() > 1e-9);
+            prop_assert_eq!(plate.is_flat_beyond(x, y, margin), depth > margin, "depth {}", depth);
+        }
+    }
+
+    /// Points chosen near every hole's reach, where the nearest hole decides: on the ray through
+    /// each centre and at the angle halfway to the next, just inside and outside.
+    #[test]
+    fn is_flat_beyond_finds_the_nearest_hole() {
+        for genus in [2, 3, 7, 32, 64] {
+            let plate = PlateLayout::new(genus);
+            let reach = plate.hole_radius + plate.band + 0.05;
+            for k in 0..genus {
+                let c = plate.hole_centre(k);
+                for (dx, dy) in [(1.0, 0.0), (0.0, 1.0), (-0.6, 0.8), (0.0, -1.0)] {
+                    for (s, flat) in [(0.999, false), (1.001, true)] {
+                        let (x, y) = (c[0] + s * reach * dx, c[1] + s * reach * dy);
+                        let expected = flat && plate.flat_depth(x, y) > 0.05;
+                        assert_eq!(plate.is_flat_beyond(x, y, 0.05), expected, "{genus} {k}");
+                    }
+                }
             }
         }
     }
