@@ -2,10 +2,10 @@
 //!
 //! - `initial_fit`: `ntori new`'s pipeline (mesh, cut, Floater, relaxation, least squares) for
 //!   genus 2, 5 and 10 at `ntori new`'s resolution, grid and smoothness (genus 5 and 10:
-//!   resolution 40), and with `--bench` genus 32 too (about 46 s a fit here, 6.4 GB, on its 377 252 triangles and grid of 64, before its edge
-//!   samples; with them `ntori new -v`'s stages up to the fit add up to 55 s against 39 s, 9.1 GB; issue 12's targets: 1 s, 5 s and
-//!   60 s for genus 2, 10 and 32). The map dominates: its sweeps and Newton steps are reported by
-//!   `ntori new`.
+//!   resolution 40), and with `--bench` genus 32 too (on its 377 252 triangles, grid of 64 and
+//!   564 018 edge samples: 50.9 s a fit here on 2026-11-29, 8.9 GB; 46 s and 6.4 GB before the
+//!   samples; issue 12's targets: 1 s, 5 s and 60 s for genus 2, 10 and 32, read 0.69 s and 4.73 s
+//!   in the same run). The map and the factorization dominate: `ntori new -v` reports the stages.
 //! - `mesh_fit`: `ntori fit`'s pipeline (greedy loops from several base vertices, the canonical
 //!   words, the map, least squares) on a genus-4 plate mesh of about 10 000 vertices (issue 14's
 //!   target: 10 s).
