@@ -6,8 +6,7 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 use charts::ChartPoint;
 use embedding::fit::{FitSettings, FitStage, InitialFit, default_mesh, initial_model_of};
-use embedding::holed::HoledMesh;
-use embedding::holed::PlateLayout;
+use embedding::holed::{HoledMesh, PlateLayout};
 use embedding::integrals::{CurvatureHistogram, cells_per_knot, surface_integrals_over};
 use embedding::{SplineSettings, Surface};
 use ntori::io::export::{self, ExportOptions, Format};
@@ -312,9 +311,9 @@ pub struct FlatFacesReport {
 
 /// [`FlatFacesReport::dense`]: |H| times the half-thickness at the curvature quadrature's points
 /// on the flat faces at least `margin` inside them ([`DENSE_FLAT_MARGIN`]), its quantiles weighted
-/// by area (to within 1%: [`CurvatureHistogram`]). A ripple narrower than the input's spacing (the fine hairlines a mean-curvature
-/// picture shows) lifts the 99th and 99.9th percentiles while the vertices' 90th stays low.
-/// Reported, not gated.
+/// by area (to within 1%: [`CurvatureHistogram`]). A ripple narrower than the input's spacing (the
+/// fine hairlines a mean-curvature picture shows) lifts the 99th and 99.9th percentiles while the
+/// vertices' 90th stays low. Reported, not gated.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct DenseFlatFaces {
     pub points: usize,
@@ -340,12 +339,12 @@ const SHAPE_SAMPLES: u32 = 16;
 pub const INTERSECTION_SAMPLES: [u32; 3] = [32, 48, 64];
 
 /// The shape measures; `dense` is the largest |κ| the Gauss–Bonnet check's quadrature found, and
-/// `flat_samples` its curvature on a plate's flat faces.
+/// `flat_curvature` the |H| it found on a plate's flat faces.
 fn measure_shape(
     fitted: &Fitted,
     diagonal: f64,
     dense: embedding::quality::CurvatureExtreme,
-    flat_samples: &CurvatureHistogram,
+    flat_curvature: &CurvatureHistogram,
     stage: &dyn Fn(&str),
 ) -> Result<ShapeReport, embedding::EmbeddingError> {
     use embedding::quality;
@@ -406,16 +405,16 @@ fn measure_shape(
         distance_samples,
         flat_faces: fitted
             .flat_faces
-            .and_then(|f| flat_faces(fitted, f, flat_samples)),
+            .and_then(|f| flat_faces(fitted, f, flat_curvature)),
     })
 }
 
 /// [`FlatFacesReport`] for the plate's faces `faces`, against the intended normals there (±z), and
-/// over the dense quadrature's points on them (`samples`).
+/// at the dense quadrature's points on them (`dense`).
 fn flat_faces(
     fitted: &Fitted,
     faces: PlateFaces,
-    samples: &CurvatureHistogram,
+    dense: &CurvatureHistogram,
 ) -> Option<FlatFacesReport> {
     let intended = fitted.intended_normals?;
     let areas = embedding::fit::vertex_areas(fitted.positions, fitted.triangles);
@@ -431,15 +430,15 @@ fn flat_faces(
         mean_curvature_p90: flat.mean_curvature_p90,
         mean_curvature_p90_times_half_thickness: flat.mean_curvature_p90 * faces.half_thickness,
         normal_p90: flat.normal_p90,
-        dense: (samples.points() > 0).then(|| {
-            let times_t = |q| samples.quantile(q) * faces.half_thickness;
+        dense: (dense.points() > 0).then(|| {
+            let times_t = |q| dense.quantile(q) * faces.half_thickness;
             DenseFlatFaces {
-                points: samples.points(),
+                points: dense.points(),
                 margin: DENSE_FLAT_MARGIN,
                 p90: times_t(0.9),
                 p99: times_t(0.99),
                 p999: times_t(0.999),
-                max: samples.max() * faces.half_thickness,
+                max: dense.max() * faces.half_thickness,
             }
         }),
     })
@@ -583,7 +582,7 @@ pub fn check(
     let on_flat_face = |p: &embedding::Point3| {
         plan.is_some_and(|plan| plan.is_flat_beyond(p.x, p.y, DENSE_FLAT_MARGIN))
     };
-    let (sums, flat_samples) =
+    let (sums, flat_curvature) =
         surface_integrals_over(&layout, surface.control_points(), cells, &on_flat_face);
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
     let curvature_error = sums.gauss_bonnet_error(genus);
@@ -592,7 +591,7 @@ pub fn check(
         max_abs: sums.largest_curvature,
         at: sums.largest_curvature_at,
     };
-    let shape = measure_shape(fitted, mesh_diagonal, dense, &flat_samples, stage)?;
+    let shape = measure_shape(fitted, mesh_diagonal, dense, &flat_curvature, stage)?;
     let shape_verdict = shape.verdict();
     Ok(NewReport {
         genus,
