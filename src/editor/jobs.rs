@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
-use embedding::fit::{FitSettings, default_resolution, initial_model, vertex_areas};
+use embedding::fit::{FitSettings, default_mesh, initial_model_of, vertex_areas};
 use embedding::mesh_fit::{self, fit_user_mesh};
 use embedding::{EmbeddingError, Layout, Point3, SplineSettings, Surface};
 
@@ -103,13 +103,14 @@ impl Jobs {
     pub fn new_model(&mut self, genus: u32, settings: SplineSettings) {
         self.spawn(format!("fitting a new genus-{genus} model"), move || {
             let fail = |source| JobError::NewModel { genus, source };
-            // The input mesh's resolution as `ntori new` chooses it.
-            let resolution = default_resolution(genus).map_err(fail)?;
-            let fit = initial_model(
-                genus,
+            // The input mesh as `ntori new` chooses it (choosing it builds it: fitted as built).
+            let (resolution, mesh) = default_mesh(genus).map_err(fail)?;
+            let fit = initial_model_of(
+                mesh,
                 resolution,
                 settings,
                 FitSettings::for_plate(genus, settings),
+                &|_| {},
             )
             .map_err(fail)?;
             Ok(JobOutput::NewModel {

@@ -1,12 +1,15 @@
 //! The 3D figures, through the offscreen renderer: figure 2 (right: the loops on the surface),
 //! figure 6 (input mesh, fitted surface, two edited surfaces) and the gallery.
 //!
-//! Models are made afresh by `embedding::fit::initial_model` (nothing is cached on disk) and kept in
+//! Models are made afresh (`embedding::fit::initial_model_of` on `default_mesh`'s mesh, what
+//! `initial_model` makes at that resolution; nothing is cached on disk) and kept in
 //! memory for the run, so the genus-2 fit serves figures 2, 6 and the gallery.
 
 use charts::{ChartPoint, ModelPoint};
 use embedding::edit::{Constraint, solve};
-use embedding::fit::{InitialFit, default_resolution, default_settings, initial_model};
+use embedding::fit::{
+    InitialFit, default_mesh, default_resolution, default_settings, initial_model_of,
+};
 use embedding::{Point3, Surface, Vector3, bounding_box};
 
 use super::geometry::side_points;
@@ -52,8 +55,8 @@ impl Studio {
             source,
         };
         let (spline, settings) = default_settings(genus);
-        let resolution = default_resolution(genus).map_err(fail)?;
-        let fit = initial_model(genus, resolution, spline, settings).map_err(fail)?;
+        let (resolution, mesh) = default_mesh(genus).map_err(fail)?;
+        let fit = initial_model_of(mesh, resolution, spline, settings, &|_| {}).map_err(fail)?;
         self.fits.push((genus, resolution, fit));
         Ok(&self.fits.last().expect("just pushed").2)
     }
