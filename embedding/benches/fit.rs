@@ -6,6 +6,9 @@
 //!   564 018 edge samples: 50.9 s a fit here on 2026-11-29, 8.9 GB; 46 s and 6.4 GB before the
 //!   samples; issue 12's targets: 1 s, 5 s and 60 s for genus 2, 10 and 32, read 0.69 s and 4.73 s
 //!   in the same run). The map and the factorization dominate: `ntori new -v` reports the stages.
+//!   The plates' wider bands (`holed::PLATE_BAND`) kept the time: on a busier day genus 2 and 10
+//!   read 1.13 s and 7.20 s against 1.07 s and 7.16 s on the narrow bands, one run each in turn
+//!   (genus 32's mesh is now 372 392 triangles, at resolution 29).
 //! - `mesh_fit`: `ntori fit`'s pipeline (greedy loops from several base vertices, the canonical
 //!   words, the map, least squares) on a genus-4 plate mesh of about 10 000 vertices (issue 14's
 //!   target: 10 s).

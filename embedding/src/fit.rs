@@ -334,7 +334,10 @@ pub const DEFAULT_FIT_TRIANGLES: usize = 300_000;
 /// The budget [`default_resolution`] keeps [`HIGH_GRID_GENERA`]'s plates within: their finer
 /// grid needs the data as dense. With it genus 30 takes resolution 32 (373 176 triangles), 31
 /// takes 31 (377 734; at 30, 356 334 triangles, its largest |κ| read 1.59× the input's, at 31
-/// 1.45×, at 32 1.38× but 398 366 triangles) and 32 takes 30 (377 252; 399 564 at 31).
+/// 1.45×, at 32 1.38× but 398 366 triangles) and 32 takes 30 (377 252; 399 564 at 31). On the
+/// plate of wide bands ([`crate::holed::PLATE_BAND`]), whose plan is larger, each takes one less:
+/// genus 30 31 (377 096 triangles, 1.53×; at 30, 357 416 and 1.37×), 31 30 (378 396, 1.38×) and
+/// 32 29 (372 392, 1.42×).
 pub const HIGH_GRID_FIT_TRIANGLES: usize = 395_000;
 const _: () = assert!(HIGH_GRID_FIT_TRIANGLES <= MAX_FIT_TRIANGLES);
 

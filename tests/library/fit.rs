@@ -442,8 +442,10 @@ fn agreement_rows_make_overlapping_patches_agree_between_the_data() {
             "genus {genus}: {free:?} → {tied:?}"
         );
         assert!(tied.max < free.max, "genus {genus}: {free:?} → {tied:?}");
+        // Still through the data: genus 3 read 3.95e-4 → 9.61e-4 of the diagonal on the plate
+        // of the wide bands (`holed::PLATE_BAND`).
         assert!(
-            tied_residual < 2.0 * free_residual.max(1e-4),
+            tied_residual < 3.0 * free_residual.max(1e-4),
             "genus {genus}"
         );
     }
@@ -637,11 +639,12 @@ fn the_default_resolution_keeps_high_genus_within_the_fit() {
             "genus {genus}: {triangles} triangles at resolution {resolution}, {finer} at the next"
         );
     }
-    // Genus 30 to 32 on their finer grid: the meshes measured with it (31 at 31 and 32 at 30; 30
-    // at its full 32), within the fit's cap.
+    // Genus 30 to 32 on their finer grid: the meshes measured with it (30 at 31, 31 at 30, 32 at
+    // 29: a resolution less than on the plate of narrow bands, whose wider plan takes more
+    // triangles), within the fit's cap.
     assert_eq!(fit_triangle_budget(31), HIGH_GRID_FIT_TRIANGLES);
     assert_eq!(fit_triangle_budget(29), DEFAULT_FIT_TRIANGLES);
-    for (genus, resolution) in [(30, 32), (31, 31), (32, 30)] {
+    for (genus, resolution) in [(30, 31), (31, 30), (32, 29)] {
         assert_eq!(
             default_resolution(genus).unwrap(),
             resolution,
