@@ -18,7 +18,7 @@ use super::write_stdout;
 /// 16 and 32 in mean curvature; genus 2 in the chart and curvature styles; PNG), and CAPTIONS.md
 /// listing every file with what it shows and the parameters that made it. The 2D figures are for
 /// genus 2, like the paper's. The whole command takes about two minutes on two cores, most of it
-/// for genus 32's fit (on its grid of 64 and 377 252 triangles, and the points between them),
+/// for genus 32's fit (on its grid of 64 and 372 392 triangles, and the points between them),
 /// and 10 GB.
 ///
 /// The PNG figures need a GPU (or a software adapter); without one they are left out with a
