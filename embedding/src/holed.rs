@@ -376,7 +376,7 @@ impl Profile {
 /// | 32 | 0.0171 → 0.0110 | 0.0491 → 0.0350 | 1.44× → 1.42× | 0.0015 → 0.0009 |
 ///
 /// The wider plan takes more triangles: where the budget binds, a resolution less (genus 30 to
-/// 32: 31, 30 and 29, against 32, 31 and 30; see `fit::HIGH_GRID_FIT_TRIANGLES`).
+/// 32: 30, 29 and 29, against 32, 31 and 30; see `fit::HIGH_GRID_FIT_TRIANGLES`).
 /// W = 0.6 and 0.7 at genus 10 went on down (0.0158, 0.0128 at 99%) but the largest |κ| rose
 /// (1.23×, 1.25×) and the normals' 90th percentile with it (0.31°, 0.51°).
 pub const PLATE_BAND: f64 = 0.5;
