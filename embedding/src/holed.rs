@@ -1189,8 +1189,9 @@ mod tests {
     }
 
     /// A plate's rims are sampled finer than without the rings, up to genus
-    /// [`RIM_REFINEMENT_UP_TO`] (from genus [`SPREAD_RINGS_UP_TO`] + 1 about [`RIM_REFINEMENT`]
-    /// times; below, the rings are spread W / T apart and add 5–12%), and the flat faces as
+    /// [`RIM_REFINEMENT_UP_TO`] (about [`RIM_REFINEMENT`] times where the rings keep their
+    /// spacing; where they are spread W / T apart, genus 4 to [`SPREAD_RINGS_UP_TO`], 5–12%), and
+    /// the flat faces as
     /// without them; beyond, the mesh is the plain one. Counted: vertices on the rims and on the
     /// flat faces, with and without (the flat faces lose 2–11% of theirs, which the plain mesh's
     /// refinement had put beside the bands).
@@ -1223,11 +1224,8 @@ mod tests {
             );
             // Spread over the wider band (W / T apart), the rings add less to what the mesh's
             // own refinement puts there.
-            let expected = if genus <= SPREAD_RINGS_UP_TO {
-                1.03..1.5
-            } else {
-                1.25..2.5
-            };
+            let spread = Plan::plate(genus, Plan::spacing(genus, resolution)).ring_spread;
+            let expected = if spread > 1.0 { 1.03..1.5 } else { 1.25..2.5 };
             assert!(expected.contains(&gain), "genus {genus}: rims x{gain}");
             assert!(
                 (0.85..1.1).contains(&change),
