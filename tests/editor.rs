@@ -1311,10 +1311,10 @@ fn lowest_upward_normal(state: &EditorState, near: Point3, at: Point3, radius: f
 
 /// The surface point on the top face at x (and y = 0): from the nearest tessellation vertex, a few
 /// Gauss–Newton steps in its chart toward (x, 0, top).
-fn top_point_at(state: &EditorState, x: f64) -> ChartPoint {
-    let start = top_point(state, x);
+fn top_point_at(state: &EditorState, x: f64, y: f64) -> ChartPoint {
+    let start = top_point_near(state, x, y);
     let top = state.surface_point(start).z;
-    let target = Point3::new(x, 0.0, top);
+    let target = Point3::new(x, y, top);
     let layout = state.layout();
     let mut p = start;
     for _ in 0..8 {
@@ -1331,13 +1331,26 @@ fn top_point_at(state: &EditorState, x: f64) -> ChartPoint {
 
 /// The tessellation vertex on top of the default model (largest z) nearest to x on the line y = 0.
 fn top_point(state: &EditorState, x: f64) -> ChartPoint {
+    top_point_near(state, x, 0.0)
+}
+
+/// The tessellation vertex on top of the default model nearest to (x, y).
+fn top_point_near(state: &EditorState, x: f64, y: f64) -> ChartPoint {
     let top = state
         .mesh()
         .positions()
         .iter()
         .map(|q| q.z)
         .fold(f64::MIN, f64::max);
-    state.nearest_vertex(Point3::new(x, 0.0, top))
+    state.nearest_vertex(Point3::new(x, y, top))
+}
+
+/// Where the default (genus-2) plate's top face is widest: on the line x = 0 between its two
+/// holes, halfway from the centre to the outer rim's band (0.8 from the holes' bands on the wide
+/// bands, 1.25 from the outer one), so that a brush there works on a flat face and not on a rim.
+fn widest_flat_y() -> f64 {
+    let plate = embedding::holed::PlateLayout::new(2);
+    0.5 * (plate.outer_radius - plate.band)
 }
 
 /// The largest distance between a point of the surface near `centre` (within 1.5 `radius` of it
@@ -1516,7 +1529,8 @@ fn each_brush_changes_the_surface_as_named() {
     let mut state = brush_state();
     let size = state.size();
     let original = state.control().to_vec();
-    let point = top_point(&state, 0.3 * size);
+    // On the widest flat face; the strokes run from there towards the plate's centre.
+    let point = top_point_near(&state, 0.0, widest_flat_y());
     let at = state.surface_point(point);
     state.influence = 0.15;
     let radius = state.radius();
@@ -1527,7 +1541,7 @@ fn each_brush_changes_the_surface_as_named() {
         state.start_stroke(point).unwrap();
         // Three more dabs along a short line (each due: half the radius apart).
         for k in 1..=3 {
-            let next = state.nearest_vertex(at + Vector3::new(0.0, 0.5 * radius * k as f64, 0.0));
+            let next = state.nearest_vertex(at - Vector3::new(0.0, 0.5 * radius * k as f64, 0.0));
             state.stroke_at(next).unwrap();
         }
         assert_eq!(state.stroke().unwrap().dabs, 4, "{kind:?}: four dabs");
@@ -1554,8 +1568,8 @@ fn each_brush_changes_the_surface_as_named() {
         );
         assert!(most > 1e-3 * size, "{kind:?} moved the surface ({most:e})");
 
-        // (Measured on the default model: at most 1.0% of the most beyond 1.2 R and 0.1% beyond
-        // 2 R, for smooth; inflate 0.4% and 0.0%. Before brushes held the control points with
+        // (Measured on the default model's widest flat face: at most 1.1% of the most beyond
+        // 1.2 R and 0.0% beyond 2 R, for smooth; inflate 0.2% and 0.0%. Before brushes held the control points with
         // little weight inside the disc, inflate left a ring of 7.6% beyond 1.2 R and smooth moved
         // an edge chart's patch 2 R away by 8.3%.)
         assert!(
@@ -1627,18 +1641,19 @@ fn each_brush_changes_the_surface_as_named() {
     state.release();
     let d1 = distance_from_plane(&state, at, radius, up);
     println!("flatten: distance from the plane {d0:.4} → {d1:.4}");
-    // (Measured: one dab takes 19% off at grid 16, 14% at grid 32, where the sharp bump is
-    // sharper; the disc reaches down into a hole's rim, where the spline cannot follow the plane.)
+    // (Measured: one dab takes 55% off. On the narrow strip between a hole's rim and the outer
+    // one, where this test pointed before the rims' bands widened, it took 14 to 19%: the disc
+    // reached down into the rims, where the spline cannot follow the plane.)
     assert!(
-        d1 < 0.9 * d0,
+        d1 < 0.7 * d0,
         "flatten: distance from the plane {d0} → {d1}"
     );
 }
 
-/// Distance from `q` to the stroke's path: the segment from `at` along y of length `length`.
+/// Distance from `q` to the stroke's path: the segment from `at` along −y of length `length`.
 fn line_distance(q: Point3, at: Point3, length: f64) -> f64 {
-    let t = (q.y - at.y).clamp(0.0, length);
-    (q - (at + Vector3::new(0.0, t, 0.0))).norm()
+    let t = (at.y - q.y).clamp(0.0, length);
+    (q - (at - Vector3::new(0.0, t, 0.0))).norm()
 }
 
 /// On `sphere` shown as `meshing`: a grab and each stroke brush with mirror symmetry in z leave it
@@ -1998,9 +2013,11 @@ fn a_grab_near_a_mirror_plane_moves_along_it_without_tearing() {
 /// does: at 0.06, 0.12, 0.2 and 0.28 R off the plane (the point and its image nearly one, then
 /// their discs overlapping less) the bump's largest principal curvature is within a quarter of a
 /// grab's without symmetry at the same point. The bump is measured where the top face was flat
-/// before the pull (|κ| under 0.05 / R), so the hole rims nearby do not count. Measured (|κ| × R,
-/// symmetric against alone): 3.50 / 3.75, 3.87 / 4.60, 3.85 / 3.99 and 4.10 / 4.88 at 0.06, 0.12,
-/// 0.2 and 0.28 R. With the images' earlier field Σ f² / Σ f (it dips between the images and
+/// before the pull (|κ| under 0.05 / R), so the hole rims nearby do not count; the plane is
+/// crossed on the plate's widest flat face. Measured (|κ| × R, symmetric against alone): 4.28 /
+/// 4.35, 4.44 / 4.18, 4.53 / 4.13 and 4.47 / 4.23 at 0.06, 0.12, 0.2 and 0.28 R. (On the line
+/// y = 0, where the holes' rims come within 0.3 of the plane, 0.28 R read 5.53 / 3.97: the
+/// single bump's top lay on the rim, which the measure leaves out.) With the images' earlier field Σ f² / Σ f (it dips between the images and
 /// leaves the picked point short of Δ, which the edit's correction then made up in a spike) the
 /// same measure read 4.54 at 0.06 R and 16.95 at 0.12 R.
 #[test]
@@ -2020,7 +2037,7 @@ fn a_symmetric_grab_at_a_mirror_plane_raises_one_smooth_bump() {
             state.influence = 0.12;
             let radius = state.radius();
             state.symmetry = symmetry;
-            let point = top_point_at(&state, off * radius);
+            let point = top_point_at(&state, off * radius, widest_flat_y());
             let at = state.surface_point(point);
             assert!((at.x - off * radius).abs() < 1e-3 * radius, "{at}");
             let curvature = |state: &EditorState, q: ChartPoint| {

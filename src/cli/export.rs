@@ -35,7 +35,7 @@ use super::write_stdout;
 /// GLB node and mesh, the 3MF object, STL's `solid` (the binary header), a PLY or OFF comment.
 ///
 /// Size: one model unit becomes S U (--scale S, --units U), by default 1 cm, so the default
-/// genus-2 model (about 5.4 units across) is a 5.4 cm object whatever the format. Formats with
+/// genus-2 model (about 6 units across) is a 6 cm object whatever the format. Formats with
 /// a unit are written in it: GLB in metres (glTF's unit), 3MF in millimetres (it declares
 /// them), STL in millimetres (it has no field for a unit; slicers read millimetres). OBJ, PLY
 /// and OFF have no unit: their numbers are S times the model's, meaning U (a comment says so).
@@ -61,7 +61,7 @@ use super::write_stdout;
 ///   ntori export model.json -o fine.ply --tolerance 0.0003 --ascii
 ///   ntori export model.json -o quads.obj --quads                 (all quads)
 ///   ntori export model.json -o regular.obj --te 32 --tr 32      (the t_e/t_r scheme)
-///   ntori export model.json -o print.3mf --scale 2      (the default model, 108 mm across)
+///   ntori export model.json -o print.3mf --scale 2      (the default model, 120 mm across)
 ///   ntori export model.json -o paint.glb --uv atlas
 #[derive(clap::Args, Debug)]
 #[command(verbatim_doc_comment)]

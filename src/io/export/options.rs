@@ -94,8 +94,8 @@ pub struct ExportOptions {
     pub name: Option<String>,
 }
 
-/// The default size: a model unit is a centimetre, so a default genus-2 model (about 5.4 units
-/// across) is a 5.4 cm object in every format: 0.054 in a glTF (metres), 54 in an STL or 3MF
+/// The default size: a model unit is a centimetre, so a default genus-2 model (about 6 units
+/// across) is a 6 cm object in every format: 0.06 in a glTF (metres), 60 in an STL or 3MF
 /// (millimetres), and its own coordinates, unchanged, in OBJ, PLY and OFF.
 pub const DEFAULT_UNITS: Units = Units::Cm;
 
