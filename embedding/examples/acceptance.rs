@@ -6,7 +6,7 @@
 //!
 //! `cargo run --release -p embedding --example acceptance [SCALE] [--large]`: SCALE (default 1)
 //! multiplies each mesh's resolution; `--large` adds the 203 056-triangle plate (a minute and a half). GRID,
-//! DISK_GRID, SMOOTHNESS, AGREEMENT, ROUNDS and EVEN (rounds of evening out) override `ntori fit`'s settings; DUMP=DIR writes each mesh
+//! DISK_GRID, SMOOTHNESS, AGREEMENT, EDGE_SAMPLES, ROUNDS and EVEN (rounds of evening out) override `ntori fit`'s settings; DUMP=DIR writes each mesh
 //! there as OBJ; ONLY=TEXT fits only the meshes whose names contain TEXT.
 #[path = "../tests/shapes/mod.rs"]
 mod shapes;
@@ -95,6 +95,7 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
         smoothness: env("SMOOTHNESS").unwrap_or(embedding::fit::default_smoothness(grid)),
         raise_smoothness: env("SMOOTHNESS").is_none(),
         agreement: env("AGREEMENT").unwrap_or(fit_defaults.agreement),
+        edge_samples: env("EDGE_SAMPLES").unwrap_or(fit_defaults.edge_samples),
         ..fit_defaults
     };
     let user = match mesh_fit::fit_user_mesh(positions, triangles, settings, fit_settings, &|_| {})

@@ -262,11 +262,13 @@ pub struct FitSettings {
     /// derivatives times the patches' difference draw ridges of curvature along the fringe.
     /// `new`'s plates take it from genus [`PLATE_AGREEMENT_FROM`] ([`FitSettings::for_plate`]).
     pub agreement: f64,
-    /// Weight of `new`'s plates' edge samples ([`HoledMesh::edge_samples`], one point of the
-    /// intended surface between the ends of each edge) as fit targets besides the vertices (0:
-    /// none; 1: a third of the data's weight). Where a chart's cells are finer than the input's
-    /// spacing, the vertices alone leave its patch free to ripple between them, which the mean
-    /// curvature draws as hairlines. `new`'s plates take [`plate_edge_samples`].
+    /// Weight of the edge samples as fit targets besides the vertices (0: none; 1: a third of the
+    /// data's weight): on `new`'s plates one point of the intended surface between the ends of
+    /// each edge ([`HoledMesh::edge_samples`]), on a user's mesh each edge's middle on the smooth
+    /// curve its ends' normals say (`mesh_fit`, `ntori fit --edge-samples`; 0 by default there).
+    /// Where a chart's cells are finer than the input's spacing, the vertices alone leave its
+    /// patch free to ripple between them, which the mean curvature draws as hairlines. `new`'s
+    /// plates take [`plate_edge_samples`].
     pub edge_samples: f64,
 }
 
@@ -1235,7 +1237,7 @@ fn edge_samples(
 /// The midpoint of the hyperbolic segment from `p` to `q` in the Poincaré disk: the isometry
 /// taking `p` to 0 takes the segment onto a radius, whose midpoint halves the distance
 /// 2 artanh |q′|.
-fn geodesic_midpoint(p: Complex64, q: Complex64) -> Complex64 {
+pub(crate) fn geodesic_midpoint(p: Complex64, q: Complex64) -> Complex64 {
     let one = Complex64::new(1.0, 0.0);
     let q1 = (q - p) / (one - p.conj() * q);
     let r = q1.norm();

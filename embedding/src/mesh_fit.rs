@@ -35,7 +35,7 @@ use num_complex::Complex64;
 
 use crate::fit::{
     Distortion, FitSettings, FitStage, Lifts, Parameterization, RELAX_TOLERANCE, deepest, diagonal,
-    fit, stereographic_points, vertex_areas,
+    fit, geodesic_midpoint, stereographic_points, vertex_areas,
 };
 use crate::harmonic::Convergence;
 use crate::quality;
@@ -181,6 +181,8 @@ pub struct MeshFit {
     pub max_residual: f64,
     /// The input mesh's bounding-box diagonal.
     pub mesh_diagonal: f64,
+    /// The edges' midpoints the fit also targeted ([`FitSettings::edge_samples`]; 0 where none).
+    pub edge_samples: usize,
 }
 
 /// The greedy loops and their canonical form.
@@ -328,7 +330,8 @@ fn finish(
     progress(FitStage::Fitting);
     let points = mapped.points;
     let diagonal = diagonal(positions);
-    let (surface, smoothness) = smooth_enough(input, &points, fit_settings, diagonal)?;
+    let (surface, smoothness) =
+        smooth_enough(input, &points, &mapped.edges, fit_settings, diagonal)?;
     let control = surface.control_points();
     let (mut sum, mut max) = (0.0, 0.0f64);
     for (p, target) in points.iter().zip(positions) {
@@ -357,6 +360,7 @@ fn finish(
         rms_residual: (sum / positions.len() as f64).sqrt(),
         max_residual: max,
         mesh_diagonal: diagonal,
+        edge_samples: mapped.edges.len(),
     })
 }
 
@@ -506,6 +510,7 @@ impl SmoothnessReport {
 fn smooth_enough(
     input: &MeshInput,
     points: &[ChartPoint],
+    edges: &[([u32; 2], ChartPoint)],
     fit_settings: FitSettings,
     diagonal: f64,
 ) -> Result<(Surface, SmoothnessReport), EmbeddingError> {
@@ -517,12 +522,22 @@ fn smooth_enough(
         areas,
         ..
     } = *input;
+    // The data: the mesh's vertices, then its edges' midpoints where they are fitted too.
+    let (mut data_points, mut targets, mut weights) =
+        (points.to_vec(), positions.to_vec(), areas.to_vec());
+    let normals = own_shape.map(|own| own.normals.as_slice());
+    for &([a, b], p) in edges {
+        let (a, b) = (a as usize, b as usize);
+        data_points.push(p);
+        targets.push(edge_middle(positions, normals, a, b));
+        weights.push(fit_settings.edge_samples * (areas[a] + areas[b]) / 12.0);
+    }
     let fit_with = |smoothness: f64| -> Result<Surface, EmbeddingError> {
         let settings = FitSettings {
             smoothness,
             ..fit_settings
         };
-        let control = fit(layout, points, positions, areas, settings)?;
+        let control = fit(layout, &data_points, &targets, &weights, settings)?;
         Surface::new(Arc::clone(atlas), layout.settings(), control)
     };
     let asked = fit_settings.smoothness;
@@ -565,6 +580,31 @@ fn smooth_enough(
     Ok((best.0, report))
 }
 
+/// Where the smooth surface through a mesh edge's ends passes between them: the midpoint of the
+/// cubic through the ends tangent to the planes of their normals (a PN triangle's edge, Vlachos et
+/// al. 2001), (a + b)/2 − ((d·n_a) n_a − (d·n_b) n_b)/8 with d = b − a, which lies on a circle
+/// through the ends to fourth order in its angle. The chord's midpoint where there are no normals
+/// or the ends' normals (any length; [`quality::vertex_normals`]) part by more than
+/// [`SHARP_EDGE_NORMALS`] (a crease the surface only rounds).
+fn edge_middle(positions: &[Point3], normals: Option<&[Vector3]>, a: usize, b: usize) -> Point3 {
+    let (p, q) = (positions[a], positions[b]);
+    let chord = p + 0.5 * (q - p);
+    let Some((na, nb)) =
+        normals.and_then(|n| Some((n[a].try_normalize(0.0)?, n[b].try_normalize(0.0)?)))
+    else {
+        return chord;
+    };
+    if na.dot(&nb) < SHARP_EDGE_NORMALS.to_radians().cos() {
+        return chord;
+    }
+    let d = q - p;
+    chord - (d.dot(&na) * na - d.dot(&nb) * nb) / 8.0
+}
+
+/// The angle (degrees) between an edge's ends' normals beyond which [`edge_middle`] takes the
+/// chord's midpoint.
+const SHARP_EDGE_NORMALS: f64 = 40.0;
+
 /// Every mesh vertex's surface point, and how the map that gave them went.
 struct Mapped {
     points: Vec<ChartPoint>,
@@ -579,6 +619,9 @@ struct Mapped {
     /// The map's distortion (the polygon's or the sphere's).
     distortion: Option<Distortion>,
     loops: LoopReport,
+    /// Each mesh edge's ends and its midpoint's surface point ([`edge_midpoints`]); empty for the
+    /// sphere's map.
+    edges: Vec<([u32; 2], ChartPoint)>,
 }
 
 /// Genus 0: the mesh mapped onto the unit sphere ([`sphere_map`]), read in the sphere's two caps.
@@ -603,6 +646,11 @@ fn map_to_sphere(
         RELAX_TOLERANCE,
     )?;
     let sphere: Vec<Point3> = map.points.iter().map(|&v| Point3::from(v)).collect();
+    let edges = if fit_settings.edge_samples > 0.0 {
+        sphere_edge_midpoints(atlas, &sphere, triangles)
+    } else {
+        Vec::new()
+    };
     Ok(Mapped {
         points: stereographic_points(atlas, &sphere),
         lifts: Vec::new(),
@@ -618,7 +666,37 @@ fn map_to_sphere(
             canonical: Vec::new(),
             closure_error: 0.0,
         },
+        edges,
     })
+}
+
+/// [`edge_midpoints`] on the sphere's map: each edge's midpoint on the great circle through its
+/// ends' images.
+fn sphere_edge_midpoints(
+    atlas: &Atlas,
+    sphere: &[Point3],
+    triangles: &[[u32; 3]],
+) -> Vec<([u32; 2], ChartPoint)> {
+    let mut seen = std::collections::HashSet::with_capacity(2 * triangles.len());
+    let mut ends = Vec::with_capacity(3 * triangles.len() / 2);
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if seen.insert((a.min(b), a.max(b))) {
+                ends.push([a, b]);
+            }
+        }
+    }
+    let middles: Vec<Point3> = ends
+        .iter()
+        .map(|&[a, b]| {
+            let m = sphere[a as usize].coords + sphere[b as usize].coords;
+            Point3::from(m / m.norm())
+        })
+        .collect();
+    ends.into_iter()
+        .zip(stereographic_points(atlas, &middles))
+        .collect()
 }
 
 /// Genus ≥ 1: the equivariant Tutte map of the best of a few markings, relaxed and reweighted.
@@ -658,6 +736,11 @@ fn map_to_polygon(
         .iter()
         .map(|&z| deepest(atlas, ModelPoint(z)))
         .collect::<Result<Vec<_>, _>>()?;
+    let edges = if fit_settings.edge_samples > 0.0 {
+        edge_midpoints(atlas, &lifts, hyperbolic)?
+    } else {
+        Vec::new()
+    };
     let loops = LoopReport {
         base: system.base,
         paths: (0..system.generators.len())
@@ -676,7 +759,39 @@ fn map_to_polygon(
         solved: Some(solved),
         distortion,
         loops,
+        edges,
     })
+}
+
+/// Each mesh edge once, with the surface point of its midpoint in the map: the hyperbolic (on the
+/// torus, Euclidean) midpoint of its ends' lifts in a triangle's frame, as for `new`'s plates'
+/// edge samples. The fit targets the edge's own midpoint there ([`FitSettings::edge_samples`]):
+/// where the map stretches a triangle over several of a chart's cells, the vertices alone leave
+/// the patch free to bulge between them.
+fn edge_midpoints(
+    atlas: &Atlas,
+    lifts: &Lifts,
+    hyperbolic: bool,
+) -> Result<Vec<([u32; 2], ChartPoint)>, EmbeddingError> {
+    let mut seen = std::collections::HashSet::with_capacity(2 * lifts.corners.len());
+    let mut edges = Vec::with_capacity(3 * lifts.corners.len() / 2);
+    for corners in &lifts.corners {
+        let z = lifts.corner_positions(corners);
+        for k in 0..3 {
+            let (a, b) = (corners[k].0, corners[(k + 1) % 3].0);
+            if !seen.insert((a.min(b), a.max(b))) {
+                continue;
+            }
+            let (p, q) = (z[k], z[(k + 1) % 3]);
+            let middle = if hyperbolic {
+                geodesic_midpoint(p, q)
+            } else {
+                0.5 * (p + q)
+            };
+            edges.push(([a, b], deepest(atlas, ModelPoint(middle))?));
+        }
+    }
+    Ok(edges)
 }
 
 /// The mesh a map is made from, and where its surface points are wanted.
@@ -1135,4 +1250,53 @@ fn equivariant_lifts(
         corners,
         base as usize,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn on_sphere(theta: f64, phi: f64) -> Vector3 {
+        Vector3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        )
+    }
+
+    proptest! {
+        /// On a sphere of radius r with its exact normals (of any length), an edge's middle lies
+        /// on the sphere to fourth order in the angle α between its ends (within α⁴ r / 8), where
+        /// the chord's sags by r(1 − cos(α/2)); across a crease (normals more than 40° apart) it
+        /// is the chord's.
+        #[test]
+        fn an_edges_middle_follows_the_surface_its_normals_say(
+            theta in 0.1f64..3.0,
+            phi in 0.0f64..6.3,
+            turn in 0.0f64..6.3,
+            angle in 0.01f64..0.6,
+            r in 0.1f64..10.0,
+            length_a in 0.1f64..5.0,
+            length_b in 0.1f64..5.0,
+        ) {
+            let n_a = on_sphere(theta, phi);
+            // The other end `angle` away along a great circle in the direction `turn`.
+            let east = Vector3::z().cross(&n_a).normalize();
+            let tangent = turn.cos() * east + turn.sin() * n_a.cross(&east);
+            let n_b = angle.cos() * n_a + angle.sin() * tangent;
+            let positions = [Point3::from(r * n_a), Point3::from(r * n_b)];
+            let normals = [length_a * n_a, length_b * n_b];
+            let middle = edge_middle(&positions, Some(&normals), 0, 1);
+            let off = (middle.coords.norm() - r).abs();
+            let chord = r * (1.0 - (0.5 * angle).cos());
+            prop_assert!(off <= angle.powi(4) * r / 8.0, "{off:e} off, the chord {chord:e}");
+            prop_assert!(off < 0.2 * chord, "{off:e} off, the chord {chord:e}");
+            let plain = edge_middle(&positions, None, 0, 1);
+            prop_assert!((plain - (positions[0] + 0.5 * (positions[1] - positions[0]))).norm() < 1e-12);
+            let creased = [n_a, on_sphere(theta + 1.0, phi)];
+            let sharp = edge_middle(&positions, Some(&creased), 0, 1);
+            prop_assert!((sharp - plain).norm() < 1e-12);
+        }
+    }
 }

@@ -597,3 +597,44 @@ fn a_box_of_twelve_triangles_fits_as_a_rounded_box() {
         "patches {apart}, distance {distance}"
     );
 }
+
+/// The knotted tube fitted with its edges' middles as data too (`FitSettings::edge_samples`):
+/// its coarse mesh (16 vertices round the tube) bends sharply between its vertices, and the
+/// middles, on the smooth curve its normals say, bring the surface's normals closer to the mesh's
+/// than the vertices alone do (measured: 0.56° → 0.44° at the 95th percentile, at most 1.9° →
+/// 1.0°) and keep its distance (0.264% → 0.263% of the diagonal). The chords' middles made the
+/// tube faceted instead (0.56° → 3.01°).
+#[test]
+fn edge_middles_bring_a_coarse_tube_closer_between_its_vertices() {
+    use embedding::quality;
+    let (positions, triangles) = shapes::trefoil_tube(160, 16, 0.45);
+    let (settings, fit_settings) = embedding::mesh_fit::default_settings(1);
+    let fit = |edge_samples: f64| {
+        let fit_settings = FitSettings {
+            edge_samples,
+            ..fit_settings
+        };
+        let fit = mesh_model(&positions, &triangles, settings, fit_settings, &|_| {}).unwrap();
+        let normals = quality::normal_deviation(
+            &fit.surface,
+            &fit.parameterization.points,
+            &positions,
+            &triangles,
+        );
+        let distance = quality::hausdorff_to_mesh(&fit.surface, 32, &positions, &triangles)
+            .unwrap()
+            .symmetric;
+        (fit.edge_samples, normals, distance)
+    };
+    let (none, plain, plain_distance) = fit(0.0);
+    let (count, with, with_distance) = fit(1.0);
+    eprintln!("{plain:?} {plain_distance:e} → {with:?} {with_distance:e}");
+    assert_eq!(none, 0);
+    assert_eq!(count, 3 * triangles.len() / 2, "one per edge");
+    assert!(with.p95 < 0.9 * plain.p95, "{plain:?} → {with:?}");
+    assert!(with.max < plain.max, "{plain:?} → {with:?}");
+    assert!(
+        with_distance < 1.02 * plain_distance,
+        "{plain_distance:e} → {with_distance:e}"
+    );
+}

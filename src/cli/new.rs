@@ -87,7 +87,7 @@ pub struct Args {
 /// sees them).
 const MAX_EDGE_SAMPLES: f64 = 1e3;
 
-fn parse_edge_samples(s: &str) -> Result<f64, String> {
+pub(super) fn parse_edge_samples(s: &str) -> Result<f64, String> {
     super::parse_weight(s, "the edge samples' weight", MAX_EDGE_SAMPLES)
 }
 
