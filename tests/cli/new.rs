@@ -171,7 +171,8 @@ fn the_default_genus_3_plate_has_fair_rims() {
     // curvature on the rims round the holes: measured largest |κ| 1.18× the input's and normals
     // 0.22° off at the 90th percentile, against 1.32× and 0.29° with the grids' term; with the
     // rims sampled finer and smooth (`holed::RIM_REFINEMENT`, `holed::Profile::Smooth`), 1.12×
-    // and 0.11°.
+    // and 0.11°; with the rims' bands wider than the plate is thick (`holed::PLATE_BAND`), 1.13×
+    // and 0.13°.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("three.json");
     let report = ntori_json(&[
@@ -193,24 +194,26 @@ fn the_default_genus_3_plate_has_fair_rims() {
         "{shape}"
     );
     // Its flat faces lie flat (issue 12: |H| times the plate's half-thickness at most 0.02 at the
-    // 90th percentile; measured 0.0112 with the eased rims, 0.0067 with the smooth ones).
+    // 90th percentile; measured 0.0112 with the eased rims, 0.0067 with the smooth ones, 0.0030
+    // on the wide bands).
     let flat = &shape["flat_faces"];
     let number = |k: &str| flat[k].as_f64().unwrap_or_else(|| panic!("{k}: {flat}"));
     assert!(number("vertices") > 1000.0, "{flat}");
     assert!(
-        number("mean_curvature_p90_times_half_thickness") < 0.012,
+        number("mean_curvature_p90_times_half_thickness") < 0.006,
         "{flat}"
     );
     assert_eq!(number("half_thickness"), 0.35, "{flat}");
     assert!(number("mean_curvature_median") <= number("mean_curvature_p90"));
     assert!(number("normal_p90") < 0.5, "{flat}");
     // And between the vertices, at the curvature quadrature's points (about a million; measured
-    // 0.0037 at 90%, 0.0171 at 99.9%, 0.038 at most, as the README shows).
+    // 0.0017 at 90%, 0.0086 at 99.9%, 0.0142 at most, as the README shows; on the narrow bands
+    // 0.0037, 0.0171 and 0.038, where the fringes at the bands' edges lifted the tail).
     let dense = &flat["dense"];
     let dense_number = |k: &str| dense[k].as_f64().unwrap_or_else(|| panic!("{k}: {dense}"));
     assert!(dense_number("points") > 100_000.0, "{dense}");
-    assert!(dense_number("p90") < 0.012, "{dense}");
-    assert!(dense_number("p999") < 0.03, "{dense}");
+    assert!(dense_number("p90") < 0.004, "{dense}");
+    assert!(dense_number("p999") < 0.015, "{dense}");
     let quantiles = ["p90", "p99", "p999", "max"].map(dense_number);
     assert!(quantiles.windows(2).all(|w| w[0] <= w[1]), "{dense}");
 }
