@@ -700,7 +700,9 @@ pub fn default_plate_smoothness(genus: u32, grid: usize) -> f64 {
 /// → 2.25×, 32 2.30× → 2.33×, 33 to 37 2.68–3.10×, genus 36 failing the curvature check), but on
 /// the finer meshes of [`DEFAULT_FIT_TRIANGLES`] it did: genus 32 read 2.18× at 2e-3 and 1.88× at
 /// 1e-2 (280 068 triangles), and 1e-2 gave 1.94–2.57× from 31 to 37 and 2.84× at 40, which was
-/// refused before (3.7×). Genus 48 still fails (4.05×); above 40 the weight was not measured.
+/// refused before (3.7×). Genus 48 failed at 4.05× on the narrow bands; on the wide ones
+/// (`holed::PLATE_BAND`) it passes at 2.97×, and genus 64 reads 3.23× at 2e-3, 3.17× at 1e-3 and
+/// 13× at 3e-2.
 pub const PLATE_SMOOTHNESS_UP_TO: u32 = 40;
 
 /// The plates' smoothness weight on grids finer than 32 up to genus [`PLATE_SMOOTHNESS_UP_TO`]
