@@ -241,12 +241,19 @@ pub fn mesh_model(
             sharp: quality::SharpEdges::of(positions, triangles),
         }
     });
+    // The edges' middles need the normals too where λ is the user's (no `own_shape`).
+    let edge_normals = (fit_settings.edge_samples > 0.0 && own_shape.is_none())
+        .then(|| quality::vertex_normals(positions, triangles));
     let input = MeshInput {
         atlas: &atlas,
         layout: &layout,
         genus,
         positions,
         own_shape: own_shape.as_ref(),
+        normals: own_shape
+            .as_ref()
+            .map(|own| own.normals.as_slice())
+            .or(edge_normals.as_deref()),
         areas: &areas,
     };
     let Some(polygon) = atlas.polygon() else {
@@ -303,6 +310,8 @@ struct MeshInput<'a> {
     positions: &'a [Point3],
     /// The mesh's own normals and largest |κ|, where λ may be raised.
     own_shape: Option<&'a OwnShape>,
+    /// The mesh's vertex normals, where λ may be raised or the edges' middles are fitted.
+    normals: Option<&'a [Vector3]>,
     areas: &'a [f64],
 }
 
@@ -519,13 +528,13 @@ fn smooth_enough(
         layout,
         positions,
         own_shape,
+        normals,
         areas,
         ..
     } = *input;
     // The data: the mesh's vertices, then its edges' midpoints where they are fitted too.
     let (mut data_points, mut targets, mut weights) =
         (points.to_vec(), positions.to_vec(), areas.to_vec());
-    let normals = own_shape.map(|own| own.normals.as_slice());
     for &([a, b], p) in edges {
         let (a, b) = (a as usize, b as usize);
         data_points.push(p);
@@ -619,8 +628,8 @@ struct Mapped {
     /// The map's distortion (the polygon's or the sphere's).
     distortion: Option<Distortion>,
     loops: LoopReport,
-    /// Each mesh edge's ends and its midpoint's surface point ([`edge_midpoints`]); empty for the
-    /// sphere's map.
+    /// Each mesh edge's ends and its midpoint's surface point ([`edge_midpoints`],
+    /// [`sphere_edge_midpoints`]); empty where the fit takes none.
     edges: Vec<([u32; 2], ChartPoint)>,
 }
 
