@@ -1309,8 +1309,8 @@ fn lowest_upward_normal(state: &EditorState, near: Point3, at: Point3, radius: f
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The surface point on the top face at x (and y = 0): from the nearest tessellation vertex, a few
-/// Gauss–Newton steps in its chart toward (x, 0, top).
+/// The surface point on the top face at (x, y): from the nearest tessellation vertex, a few
+/// Gauss–Newton steps in its chart toward (x, y, top).
 fn top_point_at(state: &EditorState, x: f64, y: f64) -> ChartPoint {
     let start = top_point_near(state, x, y);
     let top = state.surface_point(start).z;
@@ -1569,9 +1569,9 @@ fn each_brush_changes_the_surface_as_named() {
         assert!(most > 1e-3 * size, "{kind:?} moved the surface ({most:e})");
 
         // (Measured on the default model's widest flat face: at most 1.1% of the most beyond
-        // 1.2 R and 0.0% beyond 2 R, for smooth; inflate 0.2% and 0.0%. Before brushes held the control points with
-        // little weight inside the disc, inflate left a ring of 7.6% beyond 1.2 R and smooth moved
-        // an edge chart's patch 2 R away by 8.3%.)
+        // 1.2 R and 0.0% beyond 2 R, for smooth; inflate 0.2% and 0.0%. Before brushes held the
+        // control points with little weight inside the disc, inflate left a ring of 7.6% beyond
+        // 1.2 R and smooth moved an edge chart's patch 2 R away by 8.3%.)
         assert!(
             beyond(1.2) <= 0.02 && beyond(2.0) <= 0.005,
             "{kind:?}: the surface moved beyond the brush ({:.3} of the most beyond 1.2 R, {:.3} \
@@ -2017,9 +2017,10 @@ fn a_grab_near_a_mirror_plane_moves_along_it_without_tearing() {
 /// crossed on the plate's widest flat face. Measured (|κ| × R, symmetric against alone): 4.28 /
 /// 4.35, 4.44 / 4.18, 4.53 / 4.13 and 4.47 / 4.23 at 0.06, 0.12, 0.2 and 0.28 R. (On the line
 /// y = 0, where the holes' rims come within 0.3 of the plane, 0.28 R read 5.53 / 3.97: the
-/// single bump's top lay on the rim, which the measure leaves out.) With the images' earlier field Σ f² / Σ f (it dips between the images and
-/// leaves the picked point short of Δ, which the edit's correction then made up in a spike) the
-/// same measure read 4.54 at 0.06 R and 16.95 at 0.12 R.
+/// single bump's top lay on the rim, which the measure leaves out.) With the images' earlier
+/// field Σ f² / Σ f (it dips between the images and leaves the picked point short of Δ, which the
+/// edit's correction then made up in a spike) the same measure read 4.54 at 0.06 R and 16.95 at
+/// 0.12 R.
 #[test]
 fn a_symmetric_grab_at_a_mirror_plane_raises_one_smooth_bump() {
     use embedding::brush::Symmetry;

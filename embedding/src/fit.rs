@@ -1222,24 +1222,37 @@ fn edge_samples(
             parameterization.copies[ca as usize],
             parameterization.copies[cb as usize],
         );
-        let middle = if hyperbolic {
-            geodesic_midpoint(p, q)
-        } else {
-            0.5 * (p + q)
-        };
+        let middle = map_midpoint(p, q, hyperbolic);
         samples.points.push(deepest(atlas, ModelPoint(middle))?);
         samples.targets.push(e.position);
         samples
             .weights
-            .push(weight * (areas[a as usize] + areas[b as usize]) / 12.0);
+            .push(edge_sample_weight(weight, areas, e.ends));
     }
     Ok(samples)
+}
+
+/// The midpoint of the map's segment from `p` to `q`: the hyperbolic one in the Poincaré disk
+/// ([`geodesic_midpoint`]), the Euclidean one in the torus's plane.
+pub(crate) fn map_midpoint(p: Complex64, q: Complex64, hyperbolic: bool) -> Complex64 {
+    if hyperbolic {
+        geodesic_midpoint(p, q)
+    } else {
+        0.5 * (p + q)
+    }
+}
+
+/// An edge sample's fit weight: `weight` times a sixth of the mean of its ends' [`vertex_areas`]
+/// (on an even mesh, a third of a triangle each way: 1 makes the samples a third of the data's
+/// weight).
+pub(crate) fn edge_sample_weight(weight: f64, areas: &[f64], [a, b]: [u32; 2]) -> f64 {
+    weight * (areas[a as usize] + areas[b as usize]) / 12.0
 }
 
 /// The midpoint of the hyperbolic segment from `p` to `q` in the Poincaré disk: the isometry
 /// taking `p` to 0 takes the segment onto a radius, whose midpoint halves the distance
 /// 2 artanh |q′|.
-pub(crate) fn geodesic_midpoint(p: Complex64, q: Complex64) -> Complex64 {
+fn geodesic_midpoint(p: Complex64, q: Complex64) -> Complex64 {
     let one = Complex64::new(1.0, 0.0);
     let q1 = (q - p) / (one - p.conj() * q);
     let r = q1.norm();

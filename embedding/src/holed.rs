@@ -406,16 +406,15 @@ pub struct PlateLayout {
 impl PlateLayout {
     /// The plate of genus `n` (at least 2).
     pub fn new(n: u32) -> PlateLayout {
-        let thickness = PLATE_HALF_THICKNESS;
-        let hole_radius = 0.5;
-        let band = PLATE_BAND;
+        let (hole_radius, band, thickness) = (0.5, PLATE_BAND, PLATE_HALF_THICKNESS);
         let sector = PI / f64::from(n.max(2));
         // The 4n loop ends leave p₀ at equal angles δ = 2π/4n (a_k out at θ_k − δ, b_k out at θ_k,
         // a_k in at θ_k + δ, b_k in at θ_k + 2δ), so the wedges between them are congruent, like the
         // polygon's corners they flatten into. The ring is wide enough for the petal's rays to clear
         // their hole by 0.15 and for the bands of neighbouring holes to stay 0.2 apart; the outer
-        // rim's band stays 0.2 from the holes' too (each written as the narrow plate's number plus
-        // what the wider band adds).
+        // rim's band stays 0.2 from the holes' too. (Each is written as the narrow plate's number
+        // plus what the wider band adds, as when genus 2 and 3 kept the narrow band: rewritten,
+        // the sums round differently and the meshes, the example models among them, change.)
         let delta = 0.5 * sector;
         let ring = (1.3f64)
             .max((hole_radius + 0.15) / delta.sin())

@@ -35,7 +35,7 @@ use num_complex::Complex64;
 
 use crate::fit::{
     Distortion, FitSettings, FitStage, Lifts, Parameterization, RELAX_TOLERANCE, deepest, diagonal,
-    fit, geodesic_midpoint, stereographic_points, vertex_areas,
+    edge_sample_weight, fit, map_midpoint, stereographic_points, vertex_areas,
 };
 use crate::harmonic::Convergence;
 use crate::quality;
@@ -535,11 +535,10 @@ fn smooth_enough(
     // The data: the mesh's vertices, then its edges' midpoints where they are fitted too.
     let (mut data_points, mut targets, mut weights) =
         (points.to_vec(), positions.to_vec(), areas.to_vec());
-    for &([a, b], p) in edges {
-        let (a, b) = (a as usize, b as usize);
+    for &(ends, p) in edges {
         data_points.push(p);
-        targets.push(edge_middle(positions, normals, a, b));
-        weights.push(fit_settings.edge_samples * (areas[a] + areas[b]) / 12.0);
+        targets.push(edge_middle(positions, normals, ends));
+        weights.push(edge_sample_weight(fit_settings.edge_samples, areas, ends));
     }
     let fit_with = |smoothness: f64| -> Result<Surface, EmbeddingError> {
         let settings = FitSettings {
@@ -595,7 +594,8 @@ fn smooth_enough(
 /// through the ends to fourth order in its angle. The chord's midpoint where there are no normals
 /// or the ends' normals (any length; [`quality::vertex_normals`]) part by more than
 /// [`SHARP_EDGE_NORMALS`] (a crease the surface only rounds).
-fn edge_middle(positions: &[Point3], normals: Option<&[Vector3]>, a: usize, b: usize) -> Point3 {
+fn edge_middle(positions: &[Point3], normals: Option<&[Vector3]>, ends: [u32; 2]) -> Point3 {
+    let [a, b] = ends.map(|v| v as usize);
     let (p, q) = (positions[a], positions[b]);
     let chord = p + 0.5 * (q - p);
     let Some((na, nb)) =
@@ -686,16 +686,10 @@ fn sphere_edge_midpoints(
     sphere: &[Point3],
     triangles: &[[u32; 3]],
 ) -> Vec<([u32; 2], ChartPoint)> {
-    let mut seen = std::collections::HashSet::with_capacity(2 * triangles.len());
-    let mut ends = Vec::with_capacity(3 * triangles.len() / 2);
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if seen.insert((a.min(b), a.max(b))) {
-                ends.push([a, b]);
-            }
-        }
-    }
+    let ends: Vec<[u32; 2]> = each_edge_once(triangles.iter().copied())
+        .into_iter()
+        .map(|(f, k)| [triangles[f][k], triangles[f][(k + 1) % 3]])
+        .collect();
     let middles: Vec<Point3> = ends
         .iter()
         .map(|&[a, b]| {
@@ -706,6 +700,22 @@ fn sphere_edge_midpoints(
     ends.into_iter()
         .zip(stereographic_points(atlas, &middles))
         .collect()
+}
+
+/// Each edge of `triangles` once, where it first appears: the triangle's index and the corner
+/// the edge leaves (it runs from corner k to corner k + 1).
+fn each_edge_once(triangles: impl ExactSizeIterator<Item = [u32; 3]>) -> Vec<(usize, usize)> {
+    let mut seen = std::collections::HashSet::with_capacity(2 * triangles.len());
+    let mut edges = Vec::with_capacity(3 * triangles.len() / 2);
+    for (f, t) in triangles.enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if seen.insert((a.min(b), a.max(b))) {
+                edges.push((f, k));
+            }
+        }
+    }
+    edges
 }
 
 /// Genus ≥ 1: the equivariant Tutte map of the best of a few markings, relaxed and reweighted.
@@ -782,25 +792,19 @@ fn edge_midpoints(
     lifts: &Lifts,
     hyperbolic: bool,
 ) -> Result<Vec<([u32; 2], ChartPoint)>, EmbeddingError> {
-    let mut seen = std::collections::HashSet::with_capacity(2 * lifts.corners.len());
-    let mut edges = Vec::with_capacity(3 * lifts.corners.len() / 2);
-    for corners in &lifts.corners {
-        let z = lifts.corner_positions(corners);
-        for k in 0..3 {
-            let (a, b) = (corners[k].0, corners[(k + 1) % 3].0);
-            if !seen.insert((a.min(b), a.max(b))) {
-                continue;
-            }
-            let (p, q) = (z[k], z[(k + 1) % 3]);
-            let middle = if hyperbolic {
-                geodesic_midpoint(p, q)
-            } else {
-                0.5 * (p + q)
-            };
-            edges.push(([a, b], deepest(atlas, ModelPoint(middle))?));
-        }
-    }
-    Ok(edges)
+    each_edge_once(lifts.corners.iter().map(|t| t.map(|(v, _)| v)))
+        .into_iter()
+        .map(|(f, k)| {
+            let corners = &lifts.corners[f];
+            let z = lifts.corner_positions(corners);
+            let next = (k + 1) % 3;
+            let middle = map_midpoint(z[k], z[next], hyperbolic);
+            Ok((
+                [corners[k].0, corners[next].0],
+                deepest(atlas, ModelPoint(middle))?,
+            ))
+        })
+        .collect()
 }
 
 /// The mesh a map is made from, and where its surface points are wanted.
@@ -1296,15 +1300,15 @@ mod tests {
             let n_b = angle.cos() * n_a + angle.sin() * tangent;
             let positions = [Point3::from(r * n_a), Point3::from(r * n_b)];
             let normals = [length_a * n_a, length_b * n_b];
-            let middle = edge_middle(&positions, Some(&normals), 0, 1);
+            let middle = edge_middle(&positions, Some(&normals), [0, 1]);
             let off = (middle.coords.norm() - r).abs();
             let chord = r * (1.0 - (0.5 * angle).cos());
             prop_assert!(off <= angle.powi(4) * r / 8.0, "{off:e} off, the chord {chord:e}");
             prop_assert!(off < 0.2 * chord, "{off:e} off, the chord {chord:e}");
-            let plain = edge_middle(&positions, None, 0, 1);
+            let plain = edge_middle(&positions, None, [0, 1]);
             prop_assert!((plain - (positions[0] + 0.5 * (positions[1] - positions[0]))).norm() < 1e-12);
             let creased = [n_a, on_sphere(theta + 1.0, phi)];
-            let sharp = edge_middle(&positions, Some(&creased), 0, 1);
+            let sharp = edge_middle(&positions, Some(&creased), [0, 1]);
             prop_assert!((sharp - plain).norm() < 1e-12);
         }
     }

@@ -38,8 +38,8 @@ pub fn asset(name: &str) -> std::path::PathBuf {
 pub const SMALL_MODEL_GENERA: std::ops::RangeInclusive<u32> = 0..=3;
 
 /// The small fitted model of genus 0 to 3 from `assets/models/` (an 8×8 grid per chart, 10×10 in
-/// genus 3's disk charts, fitted to a resolution-16 mesh), loaded once per test binary and genus. `tests/library/assets.rs` checks that
-/// the files are what the fit makes.
+/// genus 3's disk charts, fitted to a resolution-16 mesh), loaded once per test binary and genus.
+/// `tests/library/assets.rs` checks that the files are what the fit makes.
 pub fn small_model(genus: u32) -> &'static Surface {
     static MODELS: [OnceLock<Surface>; 4] = [const { OnceLock::new() }; 4];
     assert!(
