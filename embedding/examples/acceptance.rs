@@ -132,6 +132,19 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
     if let Some(e) = fit.evening {
         println!("  evened out: {e:?}");
     }
+    let tried: Vec<String> = fit
+        .smoothness
+        .tried
+        .iter()
+        .map(|t| {
+            format!(
+                "{} ({:.2}× its tolerance)",
+                t.smoothness,
+                t.roughness.excess()
+            )
+        })
+        .collect();
+    println!("  λ {} (tried: {})", fit.smoothness.used, tried.join(", "));
     if let Some(d) = fit.parameterization.map_distortion {
         println!("  map distortion: {d:?}");
     }

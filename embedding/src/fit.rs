@@ -265,7 +265,8 @@ pub struct FitSettings {
     /// Weight of the edge samples as fit targets besides the vertices (0: none; 1: a third of the
     /// data's weight): on `new`'s plates one point of the intended surface between the ends of
     /// each edge ([`HoledMesh::edge_samples`]), on a user's mesh each edge's middle on the smooth
-    /// curve its ends' normals say (`mesh_fit`, `ntori fit --edge-samples`; 0 by default there).
+    /// curve its ends' normals say (`mesh_fit`, `ntori fit --edge-samples`;
+    /// [`crate::mesh_fit::MESH_EDGE_SAMPLES`] by default there).
     /// Where a chart's cells are finer than the input's spacing, the vertices alone leave its
     /// patch free to ripple between them, which the mean curvature draws as hairlines. `new`'s
     /// plates take [`plate_edge_samples`].

@@ -84,15 +84,16 @@ pub struct Args {
     /// Weight of the mesh's edges' midpoints as fit targets besides its vertices: one point per
     /// edge, on the smooth curve through its ends that their normals are square to (the chord's
     /// middle across a sharp edge), so the surface follows the mesh between its vertices too
-    /// (0: none; 1: a third of the vertices' weight). At 1 the evened pretzel of issue 14's tests
-    /// came from 0.47% to 0.40% of the diagonal apart and its normals from 1.67° to 1.37° off the
-    /// mesh's at the 95th percentile; a coarse mesh with sharp edges is followed more tightly
-    /// (`plate-genus-3.obj`: 0.89% → 0.50% apart, its creases rounded to a radius of 0.89% of the
-    /// diagonal instead of 3.3%, so λ rose to 0.25 and its |κ| from 1.10× to 2.04× its mesh's), and
-    /// the fit takes longer (9.8 s → 22 s there).
-    #[arg(long, value_name = "W", default_value_t = 0.0,
-          value_parser = super::new::parse_edge_samples)]
-    edge_samples: f64,
+    /// (0: none; 1: a third of the vertices' weight; default 1, and 0 with --cage, whose limit mesh
+    /// is dense already). At 1 the raw pretzel of issue 14's tests came from 0.61% to 0.57% of
+    /// the diagonal apart, and `gear-genus-1.obj` passes every check (its patches 2.2% apart
+    /// without);
+    /// a coarse mesh with sharp edges is followed more tightly (`plate-genus-3.obj`: 0.89% → 0.50%
+    /// apart, its creases rounded to a radius of 0.89% of the diagonal instead of 3.3%, so λ rose
+    /// to 0.25 and its |κ| from 1.10× to 2.04× its mesh's), and the fit takes longer (4 s → 9 s
+    /// there).
+    #[arg(long, value_name = "W", value_parser = super::new::parse_edge_samples)]
+    edge_samples: Option<f64>,
     #[command(flatten)]
     spline: FitArgs,
     /// Print the report as JSON.
@@ -145,7 +146,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?
     };
     fit.even_rounds = args.even_rounds as usize;
-    fit.edge_samples = args.edge_samples;
+    fit.edge_samples = args.edge_samples.unwrap_or(if cage.is_some() {
+        0.0
+    } else {
+        embedding::mesh_fit::MESH_EDGE_SAMPLES
+    });
     fit.surface_smoothness = embedding::mesh_fit::surface_smoothness(valid.genus);
     // λ is raised where the default leaves the surface rough, not where the user chose it.
     fit.raise_smoothness = args.spline.smoothness.is_none();
@@ -293,6 +298,7 @@ fn as_fitted<'a>(
         smoothness: fit.smoothness.used,
         agreement,
         edge_samples: fit.edge_samples,
+        integrals: fit.integrals.as_ref(),
     }
 }
 

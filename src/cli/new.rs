@@ -530,6 +530,9 @@ pub struct Fitted<'a> {
     pub agreement: f64,
     /// Points between the input's vertices the fit also targeted (`FitSettings::edge_samples`).
     pub edge_samples: usize,
+    /// The surface's Gauss–Bonnet quadrature at `cells_per_knot`, where the fit already took it
+    /// (`embedding::mesh_fit::MeshFit::integrals`); used where there are no flat faces to look at.
+    pub integrals: Option<&'a embedding::integrals::SurfaceIntegrals>,
 }
 
 /// A plate's flat faces: the input's vertices on them (`embedding::holed::HoledMesh::flat_vertices`),
@@ -569,6 +572,7 @@ pub fn check(
         smoothness,
         agreement,
         edge_samples,
+        integrals,
     } = *fitted;
     stage("integrating the curvature");
     let layout = surface.layout();
@@ -582,8 +586,10 @@ pub fn check(
     let on_flat_face = |p: &embedding::Point3| {
         plan.is_some_and(|plan| plan.is_flat_beyond(p.x, p.y, DENSE_FLAT_MARGIN))
     };
-    let (sums, flat_curvature) =
-        surface_integrals_over(&layout, surface.control_points(), cells, &on_flat_face);
+    let (sums, flat_curvature) = match (integrals, plan) {
+        (Some(sums), None) => (*sums, CurvatureHistogram::default()),
+        _ => surface_integrals_over(&layout, surface.control_points(), cells, &on_flat_face),
+    };
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
     let curvature_error = sums.gauss_bonnet_error(genus);
     stage("measuring the shape");
@@ -677,6 +683,7 @@ pub fn make(
         smoothness: fit.smoothness,
         agreement: fit.agreement,
         edge_samples,
+        integrals: None,
     };
     let report = check(&checked, start, &|s| progress.stage(s))?;
     Ok(Made {
