@@ -7,7 +7,8 @@
 //!   points; the factories' time per point and the CPU evaluator's vertices per second.
 //! - ntori: the tensor stencil (positions) and the full f64 stencil (with derivatives) at as many
 //!   tessellation vertices; build time per point and re-embedding vertices per second, on one
-//!   thread and on all cores.
+//!   thread and on all cores; and the tensor stencil's bytes streamed without its arithmetic
+//!   (`TensorStencil::stream_rows`), the ceiling memory sets for them on one core.
 //! - A triad (a = b + s·c over 192 MiB) for the memory bandwidth of this run.
 //!
 //! Each figure is the best of several runs, OpenSubdiv's and ntori's measured back to back. `cargo bench
@@ -186,6 +187,9 @@ struct Ntori {
     /// fraction of the bounding-box diagonal.
     tensor_build: (f64, f64),
     tensor_apply: (f64, f64),
+    /// The same rows' bytes streamed without the arithmetic ([`TensorStencil::stream_rows`]),
+    /// vertices/s on one thread.
+    tensor_stream: f64,
     /// OpenSubdiv's Far UpdateValues, vertices/s, timed in turns with the tensor stencil.
     rival: Option<f64>,
     tensor_bytes: f64,
@@ -229,6 +233,8 @@ impl Ntori {
         let apply_all = best_of(runs, || {
             tensor.positions_parallel(black_box(control), &mut out)
         });
+        let mut streamed = vec![Point3::origin(); pts.len()];
+        let stream = best_of(runs, || black_box(&tensor).stream_rows(&mut streamed));
         let mut exact = vec![Point3::origin(); pts.len()];
         let full_positions = best_of(runs, || full.positions(black_box(control), &mut exact));
         let (mut du, mut dv) = (
@@ -250,6 +256,7 @@ impl Ntori {
             vertices: pts.len(),
             tensor_build: (1e6 * build_one / n, 1e6 * build_all / n),
             tensor_apply: (n / apply_one, n / apply_all),
+            tensor_stream: n / stream,
             rival: rival.map(|_| n / rival_secs),
             tensor_bytes: tensor.bytes_per_row(),
             tensor_blocks: tensor.blocks() as f64 / n,
@@ -296,6 +303,13 @@ fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
         ratio(one, osd_uniform),
         ours.tensor_blocks,
         ours.tensor_error
+    );
+    println!(
+        "    its bytes alone (no arithmetic){:>10}  {:.0} B/vertex  {:.2} of triad: the kernel spends {:.0}% of its time on the sums",
+        m(ours.tensor_stream),
+        ours.tensor_bytes,
+        ours.tensor_stream * ours.tensor_bytes / triad,
+        100.0 * (1.0 - one / ours.tensor_stream).max(0.0)
     );
     if let Some(rival) = ours.rival {
         println!(

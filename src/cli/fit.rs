@@ -504,10 +504,10 @@ fn smoothness_text(report: &SmoothnessReport) -> String {
     let (asked, first, last) = (first.smoothness, first.roughness, kept.roughness);
     let largest = report.tried.last().map_or(report.used, |t| t.smoothness);
     format!(
-        "smoothness: λ raised from {asked} to {} (tried up to {largest}; measured at t = {}): at \
-         {asked} the surface's largest |κ| was {:.2}× the mesh's{}, its patches {:.3}% of the \
-         diagonal apart, its normals {:.1}° off the mesh's (90%) and its residual {:.3}%; at {}, \
-         {:.2}×, {:.3}%, {:.1}° and {:.3}%\n",
+        "smoothness: λ raised from {asked} to {} (tried up to {largest}; measured at t = {}, |κ| \
+         also at the quadrature's points where the rest passed): at {asked} the surface's largest \
+         |κ| was {:.2}× the mesh's{}, its patches {:.3}% of the diagonal apart, its normals {:.1}° \
+         off the mesh's (90%) and its residual {:.3}%; at {}, {:.2}×, {:.3}%, {:.1}° and {:.3}%\n",
         report.used,
         embedding::mesh_fit::ROUGHNESS_SAMPLES,
         first.curvature_ratio,

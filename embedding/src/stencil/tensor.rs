@@ -613,6 +613,23 @@ impl TensorStencil {
         self.portable_rows(&frame, 0, &mut out[..self.rows()]);
     }
 
+    /// What [`TensorStencil::positions`] moves, without its arithmetic: each row's start, its
+    /// blocks' indices and factors (one factor per block read, which touches each of the blocks'
+    /// cache lines) and an f64 position written. For the `anchors` bench: the ceiling memory sets
+    /// for this stencil's bytes on one core, against which the kernel's arithmetic is measured.
+    #[doc(hidden)]
+    pub fn stream_rows(&self, out: &mut [Point3]) {
+        let width = 2 * self.order;
+        for (o, span) in out.iter_mut().zip(self.row_starts.windows(2)) {
+            let mut sum = 0.0f32;
+            for k in span[0] as usize..span[1] as usize {
+                prefetch(&self.factors, width * (k + PREFETCH_BLOCKS));
+                sum += self.factors[width * k] + self.firsts[k] as f32;
+            }
+            *o = Point3::new(f64::from(sum), 0.0, 0.0);
+        }
+    }
+
     fn portable_rows(&self, frame: &ControlFrame, first_row: usize, out: &mut [Point3]) {
         match self.order {
             2 => self.kernel::<2>(frame, first_row, out),
