@@ -52,7 +52,7 @@ pub const EVEN_ROUNDS: usize = 10;
 
 /// Weight of a user's mesh's edges' middles as fit targets ([`FitSettings::edge_samples`]) where
 /// the settings do not say: one point per edge, on the smooth curve through its ends that their
-/// normals are square to ([`edge_middle`]), at a third of the vertices' weight. Without them a
+/// normals are square to (`edge_middle`), at a third of the vertices' weight. Without them a
 /// coarse mesh leaves the surface free between its vertices. Measured with `ntori fit` (0 → 1):
 ///
 /// | mesh | Hausdorff (% of the diagonal) | other |
