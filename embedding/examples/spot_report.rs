@@ -25,10 +25,7 @@ fn main() {
             surface.control_points(),
             embedding::integrals::cells_per_knot(layout.settings()),
         );
-        embedding::quality::CurvatureExtreme {
-            max_abs: sums.largest_curvature,
-            at: sums.largest_curvature_at,
-        }
+        sums.curvature_peak()
     };
     let at = k.at.expect("a point");
     let layout = surface.layout();

@@ -45,6 +45,14 @@ impl SurfaceIntegrals {
         let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
         (self.gaussian_curvature - expected).abs() / expected.abs().max(self.absolute_curvature)
     }
+
+    /// The largest |κ| over the quadrature's points and where it is, as the shape checks take it.
+    pub fn curvature_peak(&self) -> crate::quality::CurvatureExtreme {
+        crate::quality::CurvatureExtreme {
+            max_abs: self.largest_curvature,
+            at: self.largest_curvature_at,
+        }
+    }
 }
 
 /// Four-point Gauss–Legendre on [−1, 1].

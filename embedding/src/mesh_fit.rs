@@ -477,11 +477,12 @@ impl Roughness {
         let cells = crate::integrals::cells_per_knot(layout.settings());
         let sums = crate::integrals::surface_integrals(&layout, surface.control_points(), cells);
         if let Some(at) = sums.largest_curvature_at {
-            let dense = quality::CurvatureExtreme {
-                max_abs: sums.largest_curvature,
-                at: Some(at),
-            };
-            curvature.include(dense, surface.position(at), &own.sharp, band);
+            curvature.include(
+                sums.curvature_peak(),
+                surface.position(at),
+                &own.sharp,
+                band,
+            );
             roughness.curvature_ratio = curvature.away.max_abs / own.curvature;
             roughness.crease_rounding = curvature.rounding(reference.diagonal);
         }

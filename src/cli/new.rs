@@ -574,7 +574,6 @@ pub fn check(
         edge_samples,
         integrals,
     } = *fitted;
-    stage("integrating the curvature");
     let layout = surface.layout();
     let cells = cells_per_knot(layout.settings());
     // The quadrature evaluates the curvature densely anyway: it also gathers |H| where the plate
@@ -586,18 +585,25 @@ pub fn check(
     let on_flat_face = |p: &embedding::Point3| {
         plan.is_some_and(|plan| plan.is_flat_beyond(p.x, p.y, DENSE_FLAT_MARGIN))
     };
+    // A user's mesh has no flat faces to look at, and its fit may have integrated the surface
+    // already (`mesh_fit`'s smoothness ladder).
     let (sums, flat_curvature) = match (integrals, plan) {
         (Some(sums), None) => (*sums, CurvatureHistogram::default()),
-        _ => surface_integrals_over(&layout, surface.control_points(), cells, &on_flat_face),
+        _ => {
+            stage("integrating the curvature");
+            surface_integrals_over(&layout, surface.control_points(), cells, &on_flat_face)
+        }
     };
     let expected = std::f64::consts::TAU * (2.0 - 2.0 * f64::from(genus));
     let curvature_error = sums.gauss_bonnet_error(genus);
     stage("measuring the shape");
-    let dense = embedding::quality::CurvatureExtreme {
-        max_abs: sums.largest_curvature,
-        at: sums.largest_curvature_at,
-    };
-    let shape = measure_shape(fitted, mesh_diagonal, dense, &flat_curvature, stage)?;
+    let shape = measure_shape(
+        fitted,
+        mesh_diagonal,
+        sums.curvature_peak(),
+        &flat_curvature,
+        stage,
+    )?;
     let shape_verdict = shape.verdict();
     Ok(NewReport {
         genus,
