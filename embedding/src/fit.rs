@@ -1912,6 +1912,21 @@ impl Lifts {
         Distortion::of(&triangles)
     }
 
+    /// The area-weighted mean over the triangles of ln(σ₁/σ₂)², each in its corners' frame: 0 for
+    /// a conformal map.
+    pub(crate) fn log_anisotropy(&self, positions: &[Point3], hyperbolic: bool) -> f64 {
+        let (mut sum, mut total) = (0.0, 0.0);
+        for t in &self.corners {
+            let p = t.map(|(v, _)| positions[v as usize]);
+            let (area, ratio, _) = triangle_distortion(p, self.corner_positions(t), hyperbolic);
+            if ratio.is_finite() && area > 0.0 {
+                sum += area * ratio.ln().powi(2);
+                total += area;
+            }
+        }
+        if total > 0.0 { sum / total } else { 0.0 }
+    }
+
     /// Triangles whose lifted corners are not counter-clockwise (hyperbolic or Euclidean area ≤ 0):
     /// a relaxed map that is a bijection has none.
     pub(crate) fn folded_triangles(&self, hyperbolic: bool) -> usize {

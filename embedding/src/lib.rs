@@ -32,6 +32,7 @@ pub mod harmonic;
 pub mod holed;
 pub mod integrals;
 mod least_squares;
+mod marking;
 pub mod mesh_fit;
 pub mod model;
 pub mod quality;

@@ -1131,10 +1131,10 @@ struct Marked {
 /// The marking (which loop becomes which side of the polygon) decides the map: the harmonic map of
 /// a marking twisted round a handle squeezes that handle. Markings from a few well-spread base
 /// vertices (farthest-point samples along the mesh) are relaxed for [`SCREEN_SWEEPS`] sweeps each,
-/// and the one whose map stretches the surface most evenly is kept. The loop systems are found one
-/// after another (each base is the vertex farthest from the bases before it); the candidates'
-/// maps, which are most of the work, are made and scored on all cores, and the choice does not
-/// depend on the number of threads (ties go to the earlier candidate).
+/// and the one whose map keeps the surface's areas and angles best is kept ([`screen`]). The loop
+/// systems are found one after another (each base is the vertex farthest from the bases before
+/// it); the candidates' maps, which are most of the work, are made and scored on all cores, and
+/// the choice does not depend on the number of threads (ties go to the earlier candidate).
 fn best_marking(
     he: &HalfEdgeMesh,
     positions: &[Point3],
@@ -1173,8 +1173,13 @@ fn best_marking(
         .ok_or_else(|| EmbeddingError::Parameterization("the mesh has no vertices".into()))
 }
 
-/// One candidate marking's map, relaxed for [`SCREEN_SWEEPS`] sweeps, and its score: how unevenly
-/// it stretches the surface (lower is better).
+/// One base vertex's candidate markings, each relaxed for [`SCREEN_SWEEPS`] sweeps, and the better
+/// with its score (lower is better): how unevenly its map stretches the surface's areas plus how far
+/// from conformal it is, the area-weighted means of (ln stretch)² and (ln σ₁/σ₂)². The candidates
+/// are the cut-and-paste's own words and those [`crate::marking::shorten`] finds for the same
+/// loops. Measured with `examples/acceptance.rs`: the angle term picks a better base for the raw
+/// pretzel (Hausdorff 0.568% → 0.506% of the diagonal), the search's words bring the cube with
+/// tunnels from 3.18% to 2.17% (its map's σ₁/σ₂ at the 99th percentile 40 → 28).
 fn screen(
     he: &HalfEdgeMesh,
     positions: &[Point3],
@@ -1193,23 +1198,51 @@ fn screen(
         .iter()
         .map(|w| schema::dehn_reduce(w, genus))
         .collect();
-    let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
-    let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
-    lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
-    lifts.rehome(polygon);
-    let score = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
-    tracing::debug!(
-        base = system.base,
-        score,
-        "marking screened (area-weighted mean of squared log stretch)"
-    );
-    let marked = Marked {
-        system,
-        words,
-        closure_error,
-        lifts,
-    };
-    Ok((score, marked))
+    let lengths = loop_lengths(he, &system, positions);
+    let shortened = crate::marking::shorten(words.clone(), &lengths, polygon);
+    let mut candidates = vec![words];
+    if shortened.words != candidates[0] {
+        candidates.push(shortened.words);
+    }
+    let mut best: Option<(f64, Marked)> = None;
+    for words in candidates {
+        let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
+        let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
+        lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
+        lifts.rehome(polygon);
+        let stretch = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
+        let skew = lifts.log_anisotropy(positions, hyperbolic);
+        let score = stretch + skew;
+        tracing::debug!(
+            base = system.base,
+            score,
+            stretch,
+            skew,
+            "marking screened (area-weighted means of squared logs of stretch and anisotropy)"
+        );
+        if best.as_ref().is_none_or(|(b, _)| score < *b) {
+            let marked = Marked {
+                system: system.clone(),
+                words,
+                closure_error,
+                lifts,
+            };
+            best = Some((score, marked));
+        }
+    }
+    Ok(best.expect("one candidate at least"))
+}
+
+/// Each generator's loop length on the mesh: the tree's distances to its edge's ends and the edge.
+fn loop_lengths(he: &HalfEdgeMesh, system: &LoopSystem, positions: &[Point3]) -> Vec<f64> {
+    system
+        .generators
+        .iter()
+        .map(|&h| {
+            let (u, v) = (he.origin(h) as usize, he.target(h) as usize);
+            system.distance[u] + system.distance[v] + (positions[v] - positions[u]).norm()
+        })
+        .collect()
 }
 
 /// Sweeps each candidate marking is relaxed for before they are compared.

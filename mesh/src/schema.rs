@@ -557,6 +557,144 @@ fn replace(originals: &mut [Word], g: u32, image: &[Letter]) {
     }
 }
 
+/// The canonical relator ∏ₖ a_k b_k a_k⁻¹ b_k⁻¹ (k = 0 … g − 1, a_k = letter 2k, b_k = 2k + 1).
+pub fn relator(genus: usize) -> Word {
+    (0..genus as u32)
+        .flat_map(|k| {
+            let (a, b) = (letter(2 * k), letter(2 * k + 1));
+            [a, b, a.inv(), b.inv()]
+        })
+        .collect()
+}
+
+/// A change of the canonical letters that takes the relator to itself or to a conjugate of
+/// itself, so it is an automorphism of the surface group (a mapping class, as a Dehn twist acts on
+/// the loops): the letters it changes and their images; every other letter stays.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Move {
+    pub images: Vec<(u32, Word)>,
+}
+
+impl Move {
+    /// `word` with the move's images put in, freely reduced.
+    pub fn apply(&self, word: &[Letter]) -> Word {
+        let mut out = Vec::with_capacity(word.len() + 4);
+        for &l in word {
+            match self.images.iter().find(|(g, _)| *g == l.generator) {
+                Some((_, image)) if l.inverse => out.extend(inverse(image)),
+                Some((_, image)) => out.extend_from_slice(image),
+                None => out.push(l),
+            }
+        }
+        free_reduce(&out)
+    }
+
+    /// Whether the move changes any of these generators' letters.
+    pub fn touches(&self, word: &[Letter]) -> bool {
+        word.iter()
+            .any(|l| self.images.iter().any(|(g, _)| *g == l.generator))
+    }
+}
+
+/// Pair moves on handles k and k + 1, written with 1 = a_k, 2 = b_k, 3 = a_{k+1}, 4 = b_{k+1}
+/// (negative: inverse), the images of the four letters in that order. Found by a search over
+/// compositions of up to four elementary Nielsen moves x ↦ x y^{±1}, y^{±1} x on the genus-2
+/// relator that bring it to a conjugate u R u⁻¹, then conjugated back by u so that the product of
+/// the two commutators is kept exactly (and with it the relator of any genus). The first two undo
+/// each other, and so do the last two; the tests check both.
+const PAIR_MOVES: [[&[i8]; 4]; 4] = [
+    [&[1, -3, 2], &[-2, 3, 2, -3, 2], &[-2, 3, 2], &[4, -3, 2]],
+    [&[1, -2, 3], &[-3, 2, 3], &[-3, 2, 3, -2, 3], &[4, -2, 3]],
+    [
+        &[1, 4, 2],
+        &[-2, -4, 2, 4, 2],
+        &[-2, -4, 2, 4, 3, 4, 2],
+        &[-2, 4, 2],
+    ],
+    [
+        &[1, -2, -4],
+        &[4, 2, -4],
+        &[4, 2, -4, -2, 3, -2, -4],
+        &[4, 2, 4, -2, -4],
+    ],
+];
+
+/// Runs of handles whose surrounding curve [`relator_moves`] twists about: at most this many.
+/// Longer runs add moves in proportion to g² and were not needed on the meshes tried.
+const MAX_RUN: u32 = 3;
+
+/// Moves a search can change the marking by, step by step: per handle the four transvections
+/// b ↦ b a^{±1} and a ↦ a b^{±1} (the Dehn twists about a_k and b_k, which keep
+/// a_k b_k a_k⁻¹ b_k⁻¹); per pair of neighbouring handles [`PAIR_MOVES`] (which mix them, as the
+/// twists about curves running through both handles do); and the twists about the curves round
+/// runs of up to [`MAX_RUN`] neighbouring handles. Each has its inverse in the list.
+pub fn relator_moves(genus: usize) -> Vec<Move> {
+    let g = genus as u32;
+    let mut moves = Vec::new();
+    for k in 0..g {
+        let (a, b) = (letter(2 * k), letter(2 * k + 1));
+        for s in [a, a.inv()] {
+            moves.push(Move {
+                images: vec![(b.generator, vec![b, s])],
+            });
+        }
+        for s in [b, b.inv()] {
+            moves.push(Move {
+                images: vec![(a.generator, vec![a, s])],
+            });
+        }
+    }
+    // Handles are neighbours round the relator's cycle too (g − 1 and 0): a move that keeps
+    // [h_{g−1}][h_0] keeps the relator's rotation that starts with them, so it takes the relator
+    // to a conjugate of itself, which is as good (the group is the same).
+    let pairs = if g >= 2 { g } else { 0 };
+    for k in 0..pairs {
+        let named = |i: i8| {
+            let handle = (k + u32::from(i.unsigned_abs() > 2)) % g;
+            let l = letter(2 * handle + u32::from(i.unsigned_abs().is_multiple_of(2)));
+            if i < 0 { l.inv() } else { l }
+        };
+        for images in PAIR_MOVES {
+            moves.push(Move {
+                images: (1..=4i8)
+                    .map(|i| {
+                        let image = images[i as usize - 1].iter().map(|&x| named(x)).collect();
+                        (named(i).generator, image)
+                    })
+                    .collect(),
+            });
+        }
+    }
+    // The twists about the curves round runs of handles that follow each other round the cycle
+    // (not all of them): with Q their commutators' product, x ↦ Q x Q⁻¹ for their letters keeps
+    // Q, and so the relator (or a rotation of it); and the inverse twist.
+    for first in 0..g {
+        for count in 1..g.min(MAX_RUN + 1) {
+            let handles: Vec<u32> = (first..first + count).map(|h| h % g).collect();
+            let q: Word = handles
+                .iter()
+                .flat_map(|&h| {
+                    let (a, b) = (letter(2 * h), letter(2 * h + 1));
+                    [a, b, a.inv(), b.inv()]
+                })
+                .collect();
+            for q in [q.clone(), inverse(&q)] {
+                moves.push(Move {
+                    images: handles
+                        .iter()
+                        .flat_map(|&h| [2 * h, 2 * h + 1])
+                        .map(|x| {
+                            let image = [q.clone(), vec![letter(x)], inverse(&q)].concat();
+                            (x, free_reduce(&image))
+                        })
+                        .collect(),
+                });
+            }
+        }
+    }
+    moves
+}
+
 /// Dehn's algorithm for the surface group ⟨a₁, b₁, … | ∏[a_k, b_k]⟩ (genus ≥ 2): while the word
 /// holds more than half of a cyclic rotation of the relator or its inverse, replace that part by the
 /// inverse of the rest. The result is shorter, equal in the group, and (by small cancellation
@@ -584,31 +722,36 @@ pub fn dehn_reduce(word: &[Letter], genus: usize) -> Word {
     if genus < 2 {
         return w;
     }
-    let relator: Word = (0..genus as u32)
-        .flat_map(|k| {
-            let (a, b) = (letter(2 * k), letter(2 * k + 1));
-            [a, b, a.inv(), b.inv()]
-        })
-        .collect();
+    let relator = relator(genus);
     let len = relator.len();
-    let rotations: Vec<Word> = [relator.clone(), inverse(&relator)]
-        .iter()
-        .flat_map(|r| {
-            (0..len).map(move |s| {
-                let mut r = r.clone();
-                r.rotate_left(s);
-                r
-            })
-        })
-        .collect();
+    // The relator and its inverse, read cyclically. Each letter occurs once in either, so a part
+    // starting at w[start] can only start where that letter does.
+    let cycles = [relator.clone(), inverse(&relator)];
+    // Where a letter stands in the relator (a_k b_k a_k⁻¹ b_k⁻¹ from 4k) and in its inverse
+    // (where x stands at len − 1 minus x⁻¹'s place in the relator); None past the relator's letters.
+    let in_relator = |l: Letter| {
+        let (k, t) = (l.generator as usize / 2, l.generator as usize % 2);
+        (k < genus).then_some(4 * k + t + 2 * usize::from(l.inverse))
+    };
+    let starts = |l: Letter| Some([in_relator(l)?, len - 1 - in_relator(l.inv())?]);
     'outer: loop {
+        // Only a word longer than half the relator can hold more than half of it.
+        if 2 * w.len() <= len {
+            return w;
+        }
         for start in 0..w.len() {
-            for r in &rotations {
-                let matched = w[start..].iter().zip(r).take_while(|(x, y)| x == y).count();
+            // A letter that is not the relator's matches nothing.
+            let Some(at) = starts(w[start]) else {
+                continue;
+            };
+            for (r, s) in cycles.iter().zip(at) {
+                let matched = (0..len.min(w.len() - start))
+                    .take_while(|&k| w[start + k] == r[(s + k) % len])
+                    .count();
                 if 2 * matched > len {
-                    let rest = inverse(&r[matched..]);
+                    let rest: Word = (matched..len).map(|k| r[(s + k) % len]).collect();
                     let mut next = w[..start].to_vec();
-                    next.extend(rest);
+                    next.extend(inverse(&rest));
                     next.extend_from_slice(&w[start + matched..]);
                     w = free_reduce(&next);
                     continue 'outer;
@@ -658,4 +801,100 @@ pub fn edge_words(
         ));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every move keeps the relator letter for letter at every genus it applies to, changes some
+    /// letter, and is undone by another move of the list (so a search can step back).
+    #[test]
+    fn relator_moves_keep_the_relator_and_come_with_their_inverses() {
+        for genus in 1..=6 {
+            let relator = relator(genus);
+            let moves = relator_moves(genus);
+            let pairs = if genus >= 2 { genus } else { 0 };
+            let runs = genus * (genus - 1).min(MAX_RUN as usize);
+            assert_eq!(moves.len(), 4 * genus + PAIR_MOVES.len() * pairs + 2 * runs);
+            for m in &moves {
+                let moved = m.apply(&relator);
+                assert!(cyclically_equal(&moved, &relator), "genus {genus}: {m:?}");
+                assert!(m.images.iter().any(|(g, w)| w != &vec![letter(*g)]));
+                let undone = moves.iter().any(|back| {
+                    (0..2 * genus as u32).all(|g| back.apply(&m.apply(&[letter(g)])) == [letter(g)])
+                });
+                assert!(undone, "genus {genus}: no move undoes {m:?}");
+            }
+        }
+    }
+
+    /// Dehn's algorithm written plainly (every rotation of the relator and its inverse at every
+    /// start, as it was before the letters' places were looked up), as the oracle.
+    fn plain_dehn_reduce(word: &[Letter], genus: usize) -> Word {
+        let mut w = free_reduce(word);
+        let relator = relator(genus);
+        let len = relator.len();
+        let rotations: Vec<Word> = [relator.clone(), inverse(&relator)]
+            .iter()
+            .flat_map(|r| {
+                (0..len).map(move |s| {
+                    let mut r = r.clone();
+                    r.rotate_left(s);
+                    r
+                })
+            })
+            .collect();
+        'outer: loop {
+            for start in 0..w.len() {
+                for r in &rotations {
+                    let matched = w[start..].iter().zip(r).take_while(|(x, y)| x == y).count();
+                    if 2 * matched > len {
+                        let mut next = w[..start].to_vec();
+                        next.extend(inverse(&r[matched..]));
+                        next.extend_from_slice(&w[start + matched..]);
+                        w = free_reduce(&next);
+                        continue 'outer;
+                    }
+                }
+            }
+            return w;
+        }
+    }
+
+    proptest::proptest! {
+        /// Dehn's algorithm gives the oracle's word on random words, and on words that hold most
+        /// of the relator.
+        #[test]
+        fn dehn_reduce_agrees_with_the_plain_algorithm(
+            genus in 2usize..6,
+            letters in proptest::collection::vec((0u32..12, proptest::bool::ANY), 0..30),
+            cut in 0usize..24,
+            keep in 0usize..24,
+        ) {
+            let mut word: Word = letters
+                .iter()
+                .map(|&(g, inverse)| Letter { generator: g % (2 * genus as u32), inverse })
+                .collect();
+            // Most of a rotation of the relator spliced in, so the reductions are exercised.
+            let r = relator(genus);
+            let len = r.len();
+            let part: Word = (0..len / 2 + 1 + keep % (len / 2)).map(|k| r[(cut + k) % len]).collect();
+            let at = cut.min(word.len());
+            word.splice(at..at, part);
+            proptest::prop_assert_eq!(dehn_reduce(&word, genus), plain_dehn_reduce(&word, genus));
+        }
+    }
+
+    /// A move changes a word's letters only where they are the move's generators.
+    #[test]
+    fn a_move_touches_only_its_generators() {
+        let moves = relator_moves(3);
+        let word: Word = vec![letter(4), letter(5).inv()];
+        for m in &moves {
+            if !m.touches(&word) {
+                assert_eq!(m.apply(&word), word);
+            }
+        }
+    }
 }
