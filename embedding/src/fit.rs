@@ -208,6 +208,9 @@ pub const EARLY_ROUND_TOLERANCE: f64 = 1e-6;
 /// steps / 27 / 21.
 const WARMUP_SWEEPS: usize = 300;
 
+/// The largest σ₁/σ₂ [`Lifts::log_anisotropy`] counts a triangle with (a collapsed one has ∞).
+const MAX_ANISOTROPY: f64 = 1e6;
+
 /// The power of the stretch that divides the weights. The full power (Yoshizawa et al.) evens the
 /// area out most, but distorts the flat parts enough that the coarse t = 8 tessellation's thin
 /// triangles fold (genus 3 to 5 at grid 16); 0.75 for one round keeps every genus 0 to 7 clean
@@ -1913,18 +1916,35 @@ impl Lifts {
     }
 
     /// The area-weighted mean over the triangles of ln(σ₁/σ₂)², each in its corners' frame: 0 for
-    /// a conformal map.
+    /// a conformal map. A triangle the map collapses counts as σ₁/σ₂ = [`MAX_ANISOTROPY`]; a map
+    /// with a lift that is not a number is infinitely bad.
     pub(crate) fn log_anisotropy(&self, positions: &[Point3], hyperbolic: bool) -> f64 {
+        if self
+            .home
+            .iter()
+            .any(|z| !(z.re.is_finite() && z.im.is_finite()))
+        {
+            return f64::INFINITY;
+        }
         let (mut sum, mut total) = (0.0, 0.0);
         for t in &self.corners {
             let p = t.map(|(v, _)| positions[v as usize]);
             let (area, ratio, _) = triangle_distortion(p, self.corner_positions(t), hyperbolic);
-            if ratio.is_finite() && area > 0.0 {
+            if area > 0.0 {
+                let ratio = if ratio.is_nan() {
+                    MAX_ANISOTROPY
+                } else {
+                    ratio.min(MAX_ANISOTROPY)
+                };
                 sum += area * ratio.ln().powi(2);
                 total += area;
             }
         }
-        if total > 0.0 { sum / total } else { 0.0 }
+        if total > 0.0 {
+            sum / total
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// Triangles whose lifted corners are not counter-clockwise (hyperbolic or Euclidean area ≤ 0):

@@ -42,13 +42,20 @@ pub(crate) struct Marking {
 pub(crate) fn translation_length(g: &Lft, geometry: Geometry) -> f64 {
     let [a, b, c, d] = g.matrix();
     match geometry {
-        // The trace of the matrix scaled to determinant 1.
+        // The trace of the matrix scaled to determinant 1 (a product that overflowed, or lost
+        // its digits so that it reads as elliptic, is not taken for a short one).
         Geometry::Hyperbolic => {
-            2.0 * ((a + d).norm() / (2.0 * (a * d - b * c).sqrt().norm()))
-                .max(1.0)
-                .acosh()
+            let half_trace = (a + d).norm() / (2.0 * (a * d - b * c).sqrt().norm());
+            if half_trace.is_finite() && half_trace >= 1.0 - 1e-9 {
+                2.0 * half_trace.max(1.0).acosh()
+            } else {
+                f64::INFINITY
+            }
         }
-        _ => (b / d).norm(),
+        _ => {
+            let t = (b / d).norm();
+            if t.is_finite() { t } else { f64::INFINITY }
+        }
     }
 }
 
@@ -75,8 +82,11 @@ pub(crate) fn shorten(words: Vec<Word>, lengths: &[f64], polygon: &Polygon) -> M
         terms,
         depth: 0,
     };
+    // Words longer than this are not explored: an element's numbers lose their digits along a
+    // long product, and a long word is a long loop's element anyway.
+    let longest = words_cap(&start.words, genus);
     let moves = schema::relator_moves(genus);
-    let mut seen: HashSet<Vec<Word>> = HashSet::from([start.words.clone()]);
+    let mut seen: HashSet<u64> = HashSet::from([fingerprint(&start.words)]);
     let mut best = start.clone();
     let mut beam = vec![start];
     let mut stale = 0;
@@ -84,16 +94,22 @@ pub(crate) fn shorten(words: Vec<Word>, lengths: &[f64], polygon: &Polygon) -> M
         let mut next: Vec<State> = Vec::new();
         for state in &beam {
             for m in &moves {
-                let mut child = state.clone();
-                let mut changed = false;
-                for (i, w) in state.words.iter().enumerate() {
-                    if m.touches(w) {
-                        child.words[i] = schema::dehn_reduce(&m.apply(w), genus);
-                        child.terms[i] = term(&child.words[i], i);
-                        changed = true;
-                    }
+                let changed: Vec<(usize, Word)> = state
+                    .words
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, w)| m.touches(w))
+                    .map(|(i, w)| (i, schema::dehn_reduce(&m.apply(w), genus)))
+                    .collect();
+                if changed.is_empty() || changed.iter().any(|(_, w)| w.len() > longest) {
+                    continue;
                 }
-                if changed && seen.insert(child.words.clone()) {
+                let mut child = state.clone();
+                for (i, w) in changed {
+                    child.terms[i] = term(&w, i);
+                    child.words[i] = w;
+                }
+                if seen.insert(fingerprint(&child.words)) {
                     child.cost = child.terms.iter().sum();
                     child.depth += 1;
                     next.push(child);
@@ -122,6 +138,21 @@ pub(crate) fn shorten(words: Vec<Word>, lengths: &[f64], polygon: &Polygon) -> M
         cost: best.cost,
         steps: best.depth,
     }
+}
+
+/// The longest word the search explores: the longer of the starting words' longest and 2g, half
+/// the relator. (On a genus-4 plate, words of 13 letters that the search reached came with
+/// products 0.4 from the identity round a triangle in f64: their lengths could not be trusted.)
+fn words_cap(words: &[Word], genus: usize) -> usize {
+    words.iter().map(Vec::len).max().unwrap_or(0).max(2 * genus)
+}
+
+/// A marking's words hashed, to tell markings already reached (a collision only drops a state).
+fn fingerprint(words: &[Word]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    words.hash(&mut hasher);
+    hasher.finish()
 }
 
 /// A marking the search holds: the words, each loop's term of the cost, their sum, and the moves

@@ -1218,6 +1218,8 @@ fn screen(
             score,
             stretch,
             skew,
+            closure_error,
+            longest = words.iter().map(Vec::len).max().unwrap_or(0),
             "marking screened (area-weighted means of squared logs of stretch and anisotropy)"
         );
         if best.as_ref().is_none_or(|(b, _)| score < *b) {
