@@ -625,9 +625,9 @@ const MAX_RUN: u32 = 3;
 
 /// Moves a search can change the marking by, step by step: per handle the four transvections
 /// b ↦ b a^{±1} and a ↦ a b^{±1} (the Dehn twists about a_k and b_k, which keep
-/// a_k b_k a_k⁻¹ b_k⁻¹); per pair of neighbouring handles [`PAIR_MOVES`] (which mix them, as the
-/// twists about curves running through both handles do); and the twists about the curves round
-/// runs of up to [`MAX_RUN`] neighbouring handles. Each has its inverse in the list.
+/// a_k b_k a_k⁻¹ b_k⁻¹); per pair of neighbouring handles four moves found by a search (which mix
+/// them, as the twists about curves running through both handles do); and the twists about the
+/// curves round runs of up to three neighbouring handles. Each has its inverse in the list.
 pub fn relator_moves(genus: usize) -> Vec<Move> {
     let g = genus as u32;
     let mut moves = Vec::new();
