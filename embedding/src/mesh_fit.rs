@@ -223,7 +223,7 @@ pub struct LoopReport {
     pub closure_error: f64,
 }
 
-/// Candidate base vertices tried: the one whose generator loops are shortest in total is used.
+/// Candidate base vertices tried (see `best_marking`).
 const BASE_CANDIDATES: usize = 8;
 
 /// Fits a model to a closed, oriented, manifold, connected triangle mesh of any genus the atlas has
@@ -1200,14 +1200,32 @@ fn screen(
         .collect();
     let lengths = loop_lengths(he, &system, positions);
     let shortened = crate::marking::shorten(words.clone(), &lengths, polygon);
+    tracing::debug!(
+        base = system.base,
+        cost = shortened.cost,
+        moves = shortened.steps,
+        "marking searched (Σ ℓ²/L)"
+    );
     let mut candidates = vec![words];
     if shortened.words != candidates[0] {
         candidates.push(shortened.words);
     }
     let mut best: Option<(f64, Marked)> = None;
-    for words in candidates {
-        let (holonomy, closure_error) = holonomy(he, &system, polygon, &words)?;
-        let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
+    for (searched, words) in candidates.into_iter().enumerate() {
+        let map = holonomy(he, &system, polygon, &words).and_then(|(holonomy, closure_error)| {
+            let lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
+            Ok((lifts, closure_error))
+        });
+        // The searched words are checked as the canonical ones are; should they fail, the
+        // canonical ones still stand.
+        let (mut lifts, closure_error) = match map {
+            Ok(map) => map,
+            Err(e) if searched == 1 => {
+                tracing::debug!(base = system.base, "searched marking dropped: {e}");
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
         lifts.rehome(polygon);
         let stretch = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
@@ -1215,6 +1233,7 @@ fn screen(
         let score = stretch + skew;
         tracing::debug!(
             base = system.base,
+            searched = searched == 1,
             score,
             stretch,
             skew,

@@ -443,7 +443,8 @@ fn a_raw_marching_tetrahedra_mesh_fits_through_the_closer_of_two_maps() {
     let distance = d.symmetric / fit.mesh_diagonal;
     let error = gauss_bonnet_error(&fit.surface, 3);
     eprintln!("Hausdorff {distance:.4} of the diagonal, Gauss–Bonnet {error:e}, {evening:?}");
-    assert!(distance < 0.01, "Hausdorff {distance} of the diagonal");
+    // 0.506% measured; 0.568% before the screening saw anisotropy.
+    assert!(distance < 0.0055, "Hausdorff {distance} of the diagonal");
     assert!(error < 1e-5, "Gauss–Bonnet {error:e}");
 }
 
