@@ -1902,16 +1902,21 @@ impl Lifts {
         t.map(|(v, g)| g.apply(self.home[v as usize]))
     }
 
+    /// Each triangle's [`triangle_distortion`] (3D area, σ₁/σ₂, Jacobian), in its corners' frame.
+    fn triangle_distortions<'a>(
+        &'a self,
+        positions: &'a [Point3],
+        hyperbolic: bool,
+    ) -> impl Iterator<Item = (f64, f64, f64)> + 'a {
+        self.corners.iter().map(move |t| {
+            let p = t.map(|(v, _)| positions[v as usize]);
+            triangle_distortion(p, self.corner_positions(t), hyperbolic)
+        })
+    }
+
     /// The map's [`Distortion`] over every triangle, each in its corners' frame.
     pub(crate) fn distortion(&self, positions: &[Point3], hyperbolic: bool) -> Option<Distortion> {
-        let triangles: Vec<_> = self
-            .corners
-            .iter()
-            .map(|t| {
-                let p = t.map(|(v, _)| positions[v as usize]);
-                triangle_distortion(p, self.corner_positions(t), hyperbolic)
-            })
-            .collect();
+        let triangles: Vec<_> = self.triangle_distortions(positions, hyperbolic).collect();
         Distortion::of(&triangles)
     }
 
@@ -1927,9 +1932,7 @@ impl Lifts {
             return f64::INFINITY;
         }
         let (mut sum, mut total) = (0.0, 0.0);
-        for t in &self.corners {
-            let p = t.map(|(v, _)| positions[v as usize]);
-            let (area, ratio, _) = triangle_distortion(p, self.corner_positions(t), hyperbolic);
+        for (area, ratio, _) in self.triangle_distortions(positions, hyperbolic) {
             if area > 0.0 {
                 let ratio = if ratio.is_nan() {
                     MAX_ANISOTROPY

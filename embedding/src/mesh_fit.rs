@@ -1162,7 +1162,7 @@ fn best_marking(
         .into_par_iter()
         .enumerate()
         .map(|(index, system)| {
-            let (score, marked) = screen(he, positions, triangles, areas, polygon, system)?;
+            let (score, marked) = screen(he, positions, triangles, areas, polygon, system, length)?;
             Ok((score, index, marked))
         })
         .collect::<Result<Vec<_>, EmbeddingError>>()?;
@@ -1187,6 +1187,7 @@ fn screen(
     areas: &[f64],
     polygon: &Polygon,
     system: LoopSystem,
+    length: &impl Fn(u32) -> f64,
 ) -> Result<(f64, Marked), EmbeddingError> {
     let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
     let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
@@ -1198,7 +1199,7 @@ fn screen(
         .iter()
         .map(|w| schema::dehn_reduce(w, genus))
         .collect();
-    let lengths = loop_lengths(he, &system, positions);
+    let lengths = loop_lengths(he, &system, length);
     let shortened = crate::marking::shorten(words.clone(), &lengths, polygon);
     tracing::debug!(
         base = system.base,
@@ -1210,7 +1211,8 @@ fn screen(
     if shortened.words != candidates[0] {
         candidates.push(shortened.words);
     }
-    let mut best: Option<(f64, Marked)> = None;
+    // The best so far: score, words, closure error, lifts.
+    let mut best: Option<(f64, Vec<schema::Word>, f64, Lifts)> = None;
     for (searched, words) in candidates.into_iter().enumerate() {
         let map = holonomy(he, &system, polygon, &words).and_then(|(holonomy, closure_error)| {
             let lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
@@ -1241,27 +1243,29 @@ fn screen(
             longest = words.iter().map(Vec::len).max().unwrap_or(0),
             "marking screened (area-weighted means of squared logs of stretch and anisotropy)"
         );
-        if best.as_ref().is_none_or(|(b, _)| score < *b) {
-            let marked = Marked {
-                system: system.clone(),
-                words,
-                closure_error,
-                lifts,
-            };
-            best = Some((score, marked));
+        if best.as_ref().is_none_or(|(b, ..)| score < *b) {
+            best = Some((score, words, closure_error, lifts));
         }
     }
-    Ok(best.expect("one candidate at least"))
+    let (score, words, closure_error, lifts) = best.expect("one candidate at least");
+    let marked = Marked {
+        system,
+        words,
+        closure_error,
+        lifts,
+    };
+    Ok((score, marked))
 }
 
-/// Each generator's loop length on the mesh: the tree's distances to its edge's ends and the edge.
-fn loop_lengths(he: &HalfEdgeMesh, system: &LoopSystem, positions: &[Point3]) -> Vec<f64> {
+/// Each generator's loop length on the mesh, in the metric its loop system was grown in: the
+/// tree's distances to its edge's ends and the edge.
+fn loop_lengths(he: &HalfEdgeMesh, system: &LoopSystem, length: impl Fn(u32) -> f64) -> Vec<f64> {
     system
         .generators
         .iter()
         .map(|&h| {
             let (u, v) = (he.origin(h) as usize, he.target(h) as usize);
-            system.distance[u] + system.distance[v] + (positions[v] - positions[u]).norm()
+            system.distance[u] + system.distance[v] + length(h)
         })
         .collect()
 }
