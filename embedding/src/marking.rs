@@ -34,9 +34,10 @@ const LEVELS_PER_HANDLE: usize = 20;
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Marking {
     pub words: Vec<Word>,
-    /// Σ d(p, g_i p)² / L_i at the best base point p (see [`shorten`]).
+    /// Σ m_i² / L_i by the search's [`Measure`], at the best base point p.
     pub cost: f64,
-    /// That base point p, in the Poincaré disk (0 at genus 1, where every point moves alike).
+    /// That base point p, in the Poincaré disk (0 by translation length, and at genus 1, where
+    /// every point moves alike).
     pub centre: Complex64,
     /// Moves taken.
     pub steps: usize,
@@ -196,8 +197,8 @@ fn centre(
 }
 
 /// The words after a search from `words` (each greedy loop's, in the canonical letters) for the
-/// least Σ_i d(p, g_i p)² / L_i over markings and base points p, `lengths` the loops' lengths on
-/// the mesh and g_i loop i's element. The result names the same loops' elements under another
+/// least Σ_i m_i² / L_i by `measure` (with [`Measure::Displacement`], over markings and base points
+/// p), `lengths` the loops' lengths on the mesh and g_i loop i's element. The result names the same loops' elements under another
 /// identification of the surface's group with the polygon's, which the map can use as it is.
 ///
 /// Why a base point: every loop starts and ends at the mesh's base vertex, so the map takes loop i
@@ -259,7 +260,6 @@ pub(crate) fn shorten(
                     child.words[i] = w;
                 }
                 if seen.insert(fingerprint(&child.words)) {
-                    child.cost = cost_at(&child.elements, lengths, child.centre, geometry, measure);
                     child.depth += 1;
                     next.push(child);
                 }
@@ -268,6 +268,7 @@ pub(crate) fn shorten(
         if next.is_empty() {
             break;
         }
+        // Each child's cost at its own best base point, sought from its parent's.
         for child in &mut next {
             (child.centre, child.cost) =
                 centre(&child.elements, lengths, child.centre, geometry, measure);
@@ -310,8 +311,7 @@ fn fingerprint(words: &[Word]) -> u64 {
 }
 
 /// A marking the search holds: the words, their elements, the base point where their cost is
-/// least (or, for a state not yet re-centred, its parent's) and that cost, and the moves that led
-/// to it.
+/// least and that cost (a child, until ranked, holds its parent's), and the moves that led to it.
 #[derive(Clone)]
 struct State {
     words: Vec<Word>,
@@ -386,7 +386,8 @@ mod tests {
         assert!(found <= best * (1.0 + 1e-9), "{found} against {best}");
     }
 
-    /// A random element of the genus-g polygon's group: a word of up to `letters` letters.
+    /// The element of the polygon's group that `picks` name as a word (generators taken modulo
+    /// 2g).
     fn element(polygon: &Polygon, picks: &[(u32, bool)]) -> Lft {
         let genus = polygon.genus();
         let word: Word = picks
