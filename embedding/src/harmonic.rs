@@ -36,6 +36,9 @@ pub struct Convergence {
     /// The largest |F_v| at the end (frame units: how far the vertex is from its neighbours'
     /// average, where the vertex sits at the origin).
     pub residual: f64,
+    /// Stretch rounds left out because the map, reweighted by them, did not settle
+    /// ([`crate::fit::Lifts::settle_rounds`] keeps the rounds before).
+    pub rounds_dropped: usize,
 }
 
 impl Convergence {
@@ -46,6 +49,7 @@ impl Convergence {
             factorizations: self.factorizations + next.factorizations,
             sweeps: self.sweeps + next.sweeps,
             residual: next.residual,
+            rounds_dropped: self.rounds_dropped + next.rounds_dropped,
         }
     }
 }
@@ -168,6 +172,7 @@ pub(crate) fn solve(
         factorizations: 0,
         sweeps: 0,
         residual: max_norm(&f),
+        rounds_dropped: 0,
     };
     let (mut factor, analysis) = match kept.take() {
         Some(k) if k.analysis.size == system_size(lifts.home.len(), hyperbolic) => {
@@ -629,6 +634,59 @@ mod tests {
             .zip(&b.home)
             .map(|(a, b)| (a - b).norm() / (1.0 - a.norm_sqr()))
             .fold(0.0, f64::max)
+    }
+
+    /// A stretch round whose map does not settle is dropped with the rounds after it: the map
+    /// is the first round's fixed point, settled to the final tolerance, its weights not
+    /// reweighted, the same map as with no stretch rounds at all, and the report says how many
+    /// rounds went. Any other error still fails the map.
+    #[test]
+    fn a_stretch_round_that_does_not_settle_leaves_the_round_before() {
+        let (original, hyperbolic, positions) = start_with_mesh(3, 8);
+        let (mut plain, _) = start(3, 8);
+        let none = plain
+            .settle_rounds(&positions, hyperbolic, 0, &|_| {})
+            .unwrap();
+        assert_eq!(none.rounds_dropped, 0);
+        for failing in [2, 3] {
+            let (mut lifts, _) = start(3, 8);
+            let mut calls = 0;
+            let solved = lifts
+                .settle_rounds_by(
+                    &positions,
+                    hyperbolic,
+                    2,
+                    &|_| {},
+                    &mut |l, tolerance, kept| {
+                        calls += 1;
+                        if calls == failing {
+                            return Err(EmbeddingError::Parameterization("did not settle".into()));
+                        }
+                        l.settle(hyperbolic, tolerance, kept)
+                    },
+                )
+                .unwrap();
+            assert_eq!(solved.rounds_dropped, 4 - failing, "round {failing} failed");
+            assert!(solved.residual <= crate::fit::RELAX_TOLERANCE);
+            let reweighted = lifts
+                .neighbours
+                .iter()
+                .zip(&original.neighbours)
+                .any(|(a, b)| a.iter().zip(b).any(|(x, y)| x.0 != y.0));
+            assert_eq!(reweighted, failing == 3, "round {failing} failed");
+            if failing == 2 {
+                assert!(
+                    frame_gap(&lifts, &plain) < 1e-6,
+                    "{}",
+                    frame_gap(&lifts, &plain)
+                );
+            }
+        }
+        let (mut lifts, _) = start(3, 8);
+        let other = lifts.settle_rounds_by(&positions, hyperbolic, 2, &|_| {}, &mut |_, _, _| {
+            Err(EmbeddingError::NotAModel("not a map error".into()))
+        });
+        assert!(other.is_err());
     }
 
     /// Reproducible numbers in [−1, 1) from `seed` (SplitMix64), without a generator crate.

@@ -752,11 +752,19 @@ impl NewReport {
             ),
             None => count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
             Some(n) => format!(
-                "{} and {} ({}, residual {:.0e})",
+                "{} and {} ({}, residual {:.0e}){}",
                 count(self.sweeps, "sweep", "sweeps"),
                 count(n.steps, "Newton step", "Newton steps"),
                 count(n.factorizations, "factorization", "factorizations"),
-                n.residual
+                n.residual,
+                if n.rounds_dropped > 0 {
+                    format!(
+                        "; {} dropped (reweighted by the stretch, the map did not settle)",
+                        count(n.rounds_dropped, "stretch round", "stretch rounds")
+                    )
+                } else {
+                    String::new()
+                }
             ),
         }
     }
