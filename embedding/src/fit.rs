@@ -196,6 +196,15 @@ pub(crate) fn triangle_distortion(
 /// no vertex moves further than this.
 pub const RELAX_TOLERANCE: f64 = 1e-8;
 
+/// How [`Lifts::settle_rounds_by`] settles a round's map to a tolerance: [`Lifts::settle`], or a
+/// test's stand-in.
+pub(crate) type SettleRound<'a> = dyn FnMut(
+        &mut Lifts,
+        f64,
+        &mut Option<crate::harmonic::KeptJacobian>,
+    ) -> Result<Convergence, EmbeddingError>
+    + 'a;
+
 /// The tolerance of the stretch rounds before the last (`Lifts::settle_rounds`): their maps
 /// only measure the stretch that reweights the next, and a vertex off by this (in frame units,
 /// where neighbours are 10⁻² to 10⁻¹ apart) changes a triangle's area by about 10⁻⁴ of itself.
@@ -1754,11 +1763,7 @@ impl Lifts {
         hyperbolic: bool,
         stretch_rounds: usize,
         progress: &dyn Fn(FitStage),
-        settle: &mut dyn FnMut(
-            &mut Lifts,
-            f64,
-            &mut Option<crate::harmonic::KeptJacobian>,
-        ) -> Result<Convergence, EmbeddingError>,
+        settle: &mut SettleRound,
     ) -> Result<Convergence, EmbeddingError> {
         let rounds = stretch_rounds + 1;
         let tolerance = |round: usize| {

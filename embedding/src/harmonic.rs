@@ -37,7 +37,7 @@ pub struct Convergence {
     /// average, where the vertex sits at the origin).
     pub residual: f64,
     /// Stretch rounds left out because the map, reweighted by them, did not settle
-    /// ([`crate::fit::Lifts::settle_rounds`] keeps the rounds before).
+    /// (the map is then the last round that settled).
     pub rounds_dropped: usize,
 }
 
