@@ -464,6 +464,7 @@ fn a_map_that_wanders_far_into_the_disk_still_converges() {
         solved.residual <= embedding::fit::RELAX_TOLERANCE,
         "{solved:?}"
     );
+    assert_eq!(solved.rounds_dropped, 0, "{solved:?}");
 }
 
 /// Issue 14's 200 000-triangle mesh: the genus-4 plate at resolution 109 (100 444 vertices,
