@@ -1779,7 +1779,9 @@ impl Lifts {
         for round in 2..=rounds {
             progress(FitStage::Relaxing { round, rounds });
             let stretch = self.stretch(positions, hyperbolic);
-            let before = (self.home.clone(), self.neighbours.clone());
+            // Only the weights and the map change in a round: they are what a dropped round
+            // puts back (the adjacency's vertices and pairings, five times the bytes, stay).
+            let before = (self.home.clone(), self.weights());
             self.reweight(&stretch);
             match settle(self, tolerance(round), &mut kept) {
                 Ok(next) => solved = solved.then(next),
@@ -1794,7 +1796,8 @@ impl Lifts {
                         %why,
                         "a stretch round did not settle: the map keeps the rounds before it"
                     );
-                    (self.home, self.neighbours) = before;
+                    self.home = before.0;
+                    self.set_weights(&before.1);
                     let mut fresh = None;
                     solved = solved.then(settle(self, RELAX_TOLERANCE, &mut fresh)?);
                     solved.rounds_dropped += rounds + 1 - round;
@@ -1928,6 +1931,18 @@ impl Lifts {
             }
         }
         relative_stretch(&surface, &model)
+    }
+
+    /// Every neighbour's weight, vertex by vertex in [`Lifts::neighbours`]' order.
+    fn weights(&self) -> Vec<f64> {
+        self.neighbours.iter().flatten().map(|n| n.0).collect()
+    }
+
+    /// Puts back weights taken by [`Lifts::weights`].
+    fn set_weights(&mut self, weights: &[f64]) {
+        for (n, &w) in self.neighbours.iter_mut().flatten().zip(weights) {
+            n.0 = w;
+        }
     }
 
     /// Yoshizawa, Belyaev and Seidel's stretch-minimizing update, damped: each weight w_vu is divided
