@@ -97,8 +97,9 @@ pub struct Args {
     tolerance: Option<f64>,
     /// Write quads (OBJ, PLY and OFF): the quality tessellation's triangles paired into quads
     /// where the pair makes a good one, then every face split at its centre and edge midpoints
-    /// (on the surface), so the mesh is all quads; made from triangles at twice the tolerance,
-    /// as the split divides the chordal error by about four.
+    /// (on the surface), so the mesh is all quads; made from triangles at 1.4 times the
+    /// tolerance: the split divides a triangle's chordal error by about four, but a quad is not
+    /// flat, and at 1.4 its halves stay within the tolerance.
     #[arg(long, conflicts_with_all = ["te", "tr"])]
     quads: bool,
     /// Write PLY or STL as text instead of binary.
