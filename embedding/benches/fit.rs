@@ -15,7 +15,14 @@
 //! - `loops`: one greedy loop system and its canonical words on a genus-8 plate mesh split to
 //!   about 10⁶ triangles (issue 14's target: 5 s).
 //!
-//! In test mode (`cargo test --benches`) each runs once, on meshes a quarter as fine.
+//! - `baseline`: a fixed workload of the same kind, measured in the same run: faer's sparse LU of
+//!   a 160 × 160 grid's Laplacian (25 600 unknowns) and a solve. After the criterion groups, the
+//!   fits are timed once more between runs of it and printed as multiples of it, since fit times
+//!   on this shared machine moved by 50% from one day to the next (genus 2: 0.69 s, 1.07 s,
+//!   1.34 s in sessions 44, 45 and 47) while the code did not.
+//!
+//! In test mode (`cargo test --benches`) each runs once, on meshes a quarter as fine, and the
+//! ratios are not printed.
 
 use criterion::{BenchmarkId, Criterion};
 use embedding::Point3;
@@ -31,7 +38,118 @@ fn main() {
     initial_fit(&mut c, if full { &[2, 5, 10, 32] } else { &[2, 5, 10] });
     whole_mesh_fit(&mut c, if full { 34 } else { 12 });
     loops(&mut c, if full { 42 } else { 12 });
+    baseline(&mut c);
     c.final_summary();
+    if full {
+        ratios(&[2, 5, 10], 34);
+    }
+}
+
+/// The grid of [`grid_solve`] on a side.
+const BASELINE_SIDE: usize = 160;
+
+/// The baseline workload: the 5-point Laplacian of a `side` × `side` grid (Dirichlet boundary)
+/// factored by faer's sparse LU, as the map's Newton steps and the fit's normal equations are, and
+/// solved for a right-hand side of ones. Returns the solution's middle value, for `black_box`.
+fn grid_solve(side: usize) -> f64 {
+    use faer::prelude::Solve;
+    use faer::sparse::{SparseColMat, Triplet};
+    let index = |i: usize, j: usize| i * side + j;
+    let mut triplets = Vec::with_capacity(5 * side * side);
+    for i in 0..side {
+        for j in 0..side {
+            triplets.push(Triplet::new(index(i, j), index(i, j), 4.0));
+            let mut neighbour = |a: usize, b: usize| {
+                triplets.push(Triplet::new(index(i, j), index(a, b), -1.0));
+            };
+            if i > 0 {
+                neighbour(i - 1, j);
+            }
+            if i + 1 < side {
+                neighbour(i + 1, j);
+            }
+            if j > 0 {
+                neighbour(i, j - 1);
+            }
+            if j + 1 < side {
+                neighbour(i, j + 1);
+            }
+        }
+    }
+    let n = side * side;
+    let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).unwrap();
+    let lu = a.sp_lu().unwrap();
+    let x = lu.solve(faer::Mat::<f64>::ones(n, 1));
+    x[(index(side / 2, side / 2), 0)]
+}
+
+fn baseline(c: &mut Criterion) {
+    let mut group = c.benchmark_group("baseline");
+    group.sample_size(20);
+    let id = format!("sparse_lu_grid_{BASELINE_SIDE}");
+    group.bench_function(id, |b| {
+        b.iter(|| std::hint::black_box(grid_solve(BASELINE_SIDE)))
+    });
+    group.finish();
+}
+
+/// Seconds of the fastest of `runs` runs of `f`.
+fn best_of(runs: usize, mut f: impl FnMut()) -> f64 {
+    (0..runs)
+        .map(|_| {
+            let start = std::time::Instant::now();
+            f();
+            start.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Each fit timed once more, between two rounds of the baseline (the fastest of five each), and
+/// printed as a multiple of the faster round: a ratio measured in the same minute.
+fn ratios(genera: &[u32], mesh_resolution: usize) {
+    let base = || {
+        best_of(5, || {
+            std::hint::black_box(grid_solve(BASELINE_SIDE));
+        })
+    };
+    let report = |name: &str, f: &mut dyn FnMut()| {
+        let before = base();
+        let secs = best_of(1, &mut *f);
+        let after = base();
+        let baseline = before.min(after);
+        println!(
+            "{name}: {secs:.3} s = {:.1} × the baseline ({:.1} ms; {:.1} and {:.1} ms around it)",
+            secs / baseline,
+            baseline * 1e3,
+            before * 1e3,
+            after * 1e3
+        );
+    };
+    println!("ratios to the baseline (sparse LU of a {BASELINE_SIDE}² grid), measured in turns:");
+    for &genus in genera {
+        let (spline, settings) = default_settings(genus);
+        let resolution = default_resolution(genus).unwrap();
+        report(&format!("initial_fit/{genus}"), &mut || {
+            drop(initial_model(genus, resolution, spline, settings).unwrap())
+        });
+    }
+    let mesh = HoledMesh::new(4, mesh_resolution).unwrap();
+    let (settings, fit_settings) = mesh_fit::default_settings(4);
+    report(
+        &format!("mesh_fit/genus4_{}v", mesh.positions.len()),
+        &mut || {
+            drop(
+                mesh_model(
+                    &mesh.positions,
+                    &mesh.triangles,
+                    settings,
+                    fit_settings,
+                    &|_| {},
+                )
+                .unwrap(),
+            )
+        },
+    );
 }
 
 fn initial_fit(c: &mut Criterion, genera: &[u32]) {
