@@ -1131,11 +1131,20 @@ struct Marked {
 
 /// The marking (which loop becomes which side of the polygon) decides the map: the harmonic map of
 /// a marking twisted round a handle squeezes that handle. Markings from a few well-spread base
-/// vertices (farthest-point samples along the mesh) are relaxed for [`SCREEN_SWEEPS`] sweeps each,
-/// and the one whose map keeps the surface's areas and angles best is kept ([`screen`]). The loop
-/// systems are found one after another (each base is the vertex farthest from the bases before
-/// it); the candidates' maps, which are most of the work, are made and scored on all cores, and
-/// the choice does not depend on the number of threads (ties go to the earlier candidate).
+/// vertices (farthest-point samples along the mesh) are relaxed and the one whose map keeps the
+/// surface's areas and angles best is kept ([`candidates`] says which markings each base offers,
+/// [`score`] how they are compared). The loop systems are found one after another (each base is
+/// the vertex farthest from the bases before it); the candidates' maps, which are most of the
+/// work, are made and scored on all cores, and the choice does not depend on the number of threads
+/// (ties go to the earlier candidate).
+///
+/// Every candidate is relaxed for [`SCREEN_EARLY_SWEEPS`] sweeps and scored; those within
+/// [`SCREEN_KEEP`] times the best early score are relaxed for [`SCREEN_SWEEPS`] and scored again,
+/// and the best of those is kept. On the 10 706-vertex genus-4 plate (the `mesh_fit` bench) 5 of
+/// 13 candidates go on and the screen takes 3.0 s where it took 4.4 s; the early scores were
+/// within 1.5 times the final ones there (0.78 against 0.52 at most), within 1e-5 on the smaller
+/// plates, and the kept marking is the same on the plates of genus 2 to 4, the pretzel, the cube
+/// with tunnels and the trefoil tube (`examples/acceptance.rs`: the same distances).
 fn best_marking(
     he: &HalfEdgeMesh,
     positions: &[Point3],
@@ -1146,6 +1155,7 @@ fn best_marking(
 ) -> Result<Marked, EmbeddingError> {
     use rayon::prelude::*;
     let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
+    let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
     let mut systems = Vec::with_capacity(BASE_CANDIDATES);
     let mut nearest = vec![f64::INFINITY; he.vertex_count()];
     let mut base = 0u32;
@@ -1159,20 +1169,82 @@ fn best_marking(
             .unwrap_or(0) as u32;
         systems.push(system);
     }
-    let screened = systems
+    let offered = systems
+        .par_iter()
+        .map(|system| candidates(he, polygon, system, length))
+        .collect::<Result<Vec<_>, EmbeddingError>>()?;
+    // Every (base, candidate) pair, in order: the canonical words first at each base.
+    let pairs: Vec<(usize, usize, &Vec<schema::Word>)> = offered
+        .iter()
+        .enumerate()
+        .flat_map(|(s, (words, _))| words.iter().enumerate().map(move |(c, w)| (s, c, w)))
+        .collect();
+    // The early sweeps' scores alone are kept (every candidate's lifts at once would hold 16 maps
+    // of the mesh); the candidates that go on are made again and relaxed from the start.
+    let early = pairs
+        .par_iter()
+        .map(|&(s, c, words)| {
+            match start_candidate(he, positions, triangles, polygon, &systems[s], words) {
+                Ok(mut candidate) => {
+                    candidate
+                        .lifts
+                        .relax(hyperbolic, SCREEN_EARLY_SWEEPS, RELAX_TOLERANCE);
+                    Ok(Some(
+                        score(&candidate.lifts, positions, areas, hyperbolic).total,
+                    ))
+                }
+                // The searched words are checked as the canonical ones are; should they fail, the
+                // canonical ones still stand.
+                Err(e) if c > 0 => {
+                    tracing::debug!(base = systems[s].base, "searched marking dropped: {e}");
+                    Ok(None)
+                }
+                Err(e) => Err(e),
+            }
+        })
+        .collect::<Result<Vec<Option<f64>>, EmbeddingError>>()?;
+    let best_early = early
+        .iter()
+        .flatten()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let (best, k, candidate) = early
         .into_par_iter()
         .enumerate()
-        .map(|(index, system)| {
-            let (score, marked, spare) =
-                screen(he, positions, triangles, areas, polygon, system, length)?;
-            Ok((score, index, marked, spare))
+        .filter_map(|(k, early)| {
+            let early = early?;
+            let (s, _, words) = pairs[k];
+            let base = systems[s].base;
+            // Where no early score is finite, none can be told apart yet: every candidate goes on.
+            let promising = early <= SCREEN_KEEP * best_early || !best_early.is_finite();
+            if !promising {
+                tracing::debug!(base, early, "marking dropped after the early sweeps");
+                return None;
+            }
+            let mut candidate =
+                start_candidate(he, positions, triangles, polygon, &systems[s], words).ok()?;
+            candidate
+                .lifts
+                .relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
+            candidate.lifts.rehome(polygon);
+            let full = score(&candidate.lifts, positions, areas, hyperbolic);
+            tracing::debug!(
+                base,
+                early,
+                score = full.total,
+                stretch = full.stretch,
+                skew = full.skew,
+                closure_error = candidate.closure_error,
+                longest = candidate.words.iter().map(Vec::len).max().unwrap_or(0),
+                "marking screened (area-weighted means of squared logs of stretch and anisotropy)"
+            );
+            Some((full, k, candidate))
         })
-        .collect::<Result<Vec<_>, EmbeddingError>>()?;
-    let (score, _, marked, spare) = screened
-        .into_iter()
-        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
-        .ok_or_else(|| EmbeddingError::Parameterization("the mesh has no vertices".into()))?;
-    let Some(spare) = spare else {
+        .min_by(|a, b| a.0.total.total_cmp(&b.0.total).then(a.1.cmp(&b.1)))
+        .ok_or_else(|| EmbeddingError::Parameterization("no marking's map could be made".into()))?;
+    let s = pairs[k].0;
+    let marked = candidate.marked(systems.swap_remove(s));
+    let Some(spare) = offered[s].1.clone() else {
         return Ok(marked);
     };
     match relax_candidate(
@@ -1184,7 +1256,9 @@ fn best_marking(
         &marked.system,
         spare,
     ) {
-        Ok((spare_score, candidate)) if spare_score < score => Ok(candidate.marked(marked.system)),
+        Ok((spare_score, candidate)) if spare_score < best.total => {
+            Ok(candidate.marked(marked.system))
+        }
         Ok(_) => Ok(marked),
         Err(e) => {
             tracing::debug!(base = marked.system.base, "spare marking dropped: {e}");
@@ -1193,28 +1267,25 @@ fn best_marking(
     }
 }
 
-/// One base vertex's candidate markings, each relaxed for [`SCREEN_SWEEPS`] sweeps, and the best
-/// with its score (lower is better): how unevenly its map stretches the surface's areas plus how far
-/// from conformal it is, the area-weighted means of (ln stretch)² and (ln σ₁/σ₂)². The candidates
-/// are the cut-and-paste's own words and those [`crate::marking::shorten`] finds for the same
-/// loops by [`Measure::Displacement`]; the words it finds by [`Measure::Translation`] come back
-/// unrelaxed as a spare, which [`best_marking`] tries at the winning base only (relaxing them at
-/// every base made the `mesh_fit` bench 10.20 s against 9.82 s).
+/// One base vertex's candidate markings, and a spare: the cut-and-paste's own words, and those
+/// [`crate::marking::shorten`] finds for the same loops by [`Measure::Displacement`] (where they
+/// differ); the words it finds by [`Measure::Translation`] are the spare, which [`best_marking`]
+/// tries at the winning base only (relaxing them at every base made the `mesh_fit` bench 10.20 s
+/// against 9.82 s).
 ///
-/// Measured with `examples/acceptance.rs`: the angle term picks a better base for the raw pretzel
-/// (Hausdorff 0.568% → 0.506% of the diagonal); the translation search's words brought the cube
-/// with tunnels from 3.18% to 2.17% (its map's σ₁/σ₂ at the 99th percentile 40 → 28); the
+/// Measured with `examples/acceptance.rs`: the angle term of [`score`] picks a better base for the
+/// raw pretzel (Hausdorff 0.568% → 0.506% of the diagonal); the translation search's words brought
+/// the cube with tunnels from 3.18% to 2.17% (its map's σ₁/σ₂ at the 99th percentile 40 → 28); the
 /// displacement search's the raw pretzel from 0.506% to 0.331% (base 0's score 2.54 → 2.47, where
 /// the translation search's words scored 3.82).
-fn screen(
+type Offered = (Vec<Vec<schema::Word>>, Option<Vec<schema::Word>>);
+
+fn candidates(
     he: &HalfEdgeMesh,
-    positions: &[Point3],
-    triangles: &[[u32; 3]],
-    areas: &[f64],
     polygon: &Polygon,
-    system: LoopSystem,
+    system: &LoopSystem,
     length: &impl Fn(u32) -> f64,
-) -> Result<(f64, Marked, Option<Vec<schema::Word>>), EmbeddingError> {
+) -> Result<Offered, EmbeddingError> {
     let fail = |e: schema::SchemaError| EmbeddingError::Parameterization(e.to_string());
     let genus = polygon.genus() as usize;
     let canonical =
@@ -1224,7 +1295,7 @@ fn screen(
         .iter()
         .map(|w| schema::dehn_reduce(w, genus))
         .collect();
-    let lengths = loop_lengths(he, &system, length);
+    let lengths = loop_lengths(he, system, length);
     let [displaced, translated] = [Measure::Displacement, Measure::Translation].map(|measure| {
         let searched = crate::marking::shorten(words.clone(), &lengths, polygon, measure);
         tracing::debug!(
@@ -1238,29 +1309,11 @@ fn screen(
         searched.words
     });
     let spare = (translated != words && translated != displaced).then_some(translated);
-    let mut candidates = vec![words];
-    if displaced != candidates[0] {
-        candidates.push(displaced);
+    let mut offered = vec![words];
+    if displaced != offered[0] {
+        offered.push(displaced);
     }
-    let mut best: Option<(f64, Candidate)> = None;
-    for (searched, words) in candidates.into_iter().enumerate() {
-        // The searched words are checked as the canonical ones are; should they fail, the
-        // canonical ones still stand.
-        let (score, candidate) =
-            match relax_candidate(he, positions, triangles, areas, polygon, &system, words) {
-                Ok(relaxed) => relaxed,
-                Err(e) if searched > 0 => {
-                    tracing::debug!(base = system.base, "searched marking dropped: {e}");
-                    continue;
-                }
-                Err(e) => return Err(e),
-            };
-        if best.as_ref().is_none_or(|(b, _)| score < *b) {
-            best = Some((score, candidate));
-        }
-    }
-    let (score, candidate) = best.expect("one candidate at least");
-    Ok((score, candidate.marked(system), spare))
+    Ok((offered, spare))
 }
 
 /// A marking's words and the map they define, relaxed.
@@ -1281,8 +1334,46 @@ impl Candidate {
     }
 }
 
+/// The map of `words` on `system`'s loops, before any sweep.
+fn start_candidate(
+    he: &HalfEdgeMesh,
+    positions: &[Point3],
+    triangles: &[[u32; 3]],
+    polygon: &Polygon,
+    system: &LoopSystem,
+    words: &[schema::Word],
+) -> Result<Candidate, EmbeddingError> {
+    let (holonomy, closure_error) = holonomy(he, system, polygon, words)?;
+    let lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
+    Ok(Candidate {
+        words: words.to_vec(),
+        closure_error,
+        lifts,
+    })
+}
+
+/// How a candidate's map compares (lower is better): how unevenly it stretches the surface's
+/// areas plus how far from conformal it is, the area-weighted means of (ln stretch)² and
+/// (ln σ₁/σ₂)².
+#[derive(Clone, Copy, Debug)]
+struct Score {
+    total: f64,
+    stretch: f64,
+    skew: f64,
+}
+
+fn score(lifts: &Lifts, positions: &[Point3], areas: &[f64], hyperbolic: bool) -> Score {
+    let stretch = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
+    let skew = lifts.log_anisotropy(positions, hyperbolic);
+    Score {
+        total: stretch + skew,
+        stretch,
+        skew,
+    }
+}
+
 /// The map of `words` on `system`'s loops, relaxed for [`SCREEN_SWEEPS`] sweeps, and its score
-/// (see [`screen`]).
+/// (see [`score`]).
 fn relax_candidate(
     he: &HalfEdgeMesh,
     positions: &[Point3],
@@ -1293,28 +1384,18 @@ fn relax_candidate(
     words: Vec<schema::Word>,
 ) -> Result<(f64, Candidate), EmbeddingError> {
     let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
-    let (holonomy, closure_error) = holonomy(he, system, polygon, &words)?;
-    let mut lifts = equivariant_lifts(he, positions, triangles, &holonomy, system.base)?;
-    lifts.relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
-    lifts.rehome(polygon);
-    let stretch = uneven_stretch(&lifts.stretch(positions, hyperbolic), areas);
-    let skew = lifts.log_anisotropy(positions, hyperbolic);
-    let score = stretch + skew;
+    let mut candidate = start_candidate(he, positions, triangles, polygon, system, &words)?;
+    candidate
+        .lifts
+        .relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
+    candidate.lifts.rehome(polygon);
+    let scored = score(&candidate.lifts, positions, areas, hyperbolic);
     tracing::debug!(
         base = system.base,
-        score,
-        stretch,
-        skew,
-        closure_error,
-        longest = words.iter().map(Vec::len).max().unwrap_or(0),
-        "marking screened (area-weighted means of squared logs of stretch and anisotropy)"
+        score = scored.total,
+        "spare marking screened"
     );
-    let candidate = Candidate {
-        words,
-        closure_error,
-        lifts,
-    };
-    Ok((score, candidate))
+    Ok((scored.total, candidate))
 }
 
 /// Each generator's loop length on the mesh, in the metric its loop system was grown in: the
@@ -1332,6 +1413,12 @@ fn loop_lengths(he: &HalfEdgeMesh, system: &LoopSystem, length: impl Fn(u32) -> 
 
 /// Sweeps each candidate marking is relaxed for before they are compared.
 const SCREEN_SWEEPS: usize = 1000;
+
+/// Sweeps every candidate gets before the weaker ones are dropped ([`best_marking`]).
+const SCREEN_EARLY_SWEEPS: usize = 250;
+
+/// How many times the best early score a candidate's may be and still go on to [`SCREEN_SWEEPS`].
+const SCREEN_KEEP: f64 = 2.0;
 
 /// The area-weighted mean of (ln stretch)²: 0 for a map that shrinks the surface evenly.
 fn uneven_stretch(stretch: &[f64], areas: &[f64]) -> f64 {

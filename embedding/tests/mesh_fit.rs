@@ -415,7 +415,7 @@ fn irregular_meshes_of_other_shapes_fit_without_folds() {
 /// wrinkled: 3.1% of the diagonal from the mesh (Hausdorff), Gauss–Bonnet off by 2.9e-2, 12 735
 /// crossing triangle pairs. So a second map is made from the mesh evened out along itself
 /// (`mesh::even`), and the one whose fit comes closer to the mesh's own vertices is kept. Since
-/// the candidates are also scored by how far from conformal their maps are (`mesh_fit::screen`),
+/// the candidates are also scored by how far from conformal their maps are (`mesh_fit::score`),
 /// the map of the mesh as it is comes closer (its fit's largest residual 0.023 against 0.032
 /// evened out), and is kept. Since the marking search counts how far each loop's element moves the
 /// loops' shared base point (`marking::Measure::Displacement`), it is 0.331% of the diagonal
