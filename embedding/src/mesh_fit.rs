@@ -1179,58 +1179,76 @@ fn best_marking(
         .enumerate()
         .flat_map(|(s, (words, _))| words.iter().enumerate().map(move |(c, w)| (s, c, w)))
         .collect();
-    // The early sweeps' scores alone are kept (every candidate's lifts at once would hold 16 maps
-    // of the mesh); the candidates that go on are made again and relaxed from the start.
+    // The early sweeps' scores alone are kept, but for the maps that have settled in them (every
+    // candidate's lifts at once would hold 16 maps of the mesh): the candidates that go on are made
+    // again and relaxed from the start.
     let early = pairs
         .par_iter()
         .map(|&(s, c, words)| {
             match start_candidate(he, positions, triangles, polygon, &systems[s], words) {
                 Ok(mut candidate) => {
-                    candidate
-                        .lifts
-                        .relax(hyperbolic, SCREEN_EARLY_SWEEPS, RELAX_TOLERANCE);
-                    Ok(Some(
-                        score(&candidate.lifts, positions, areas, hyperbolic).total,
-                    ))
+                    let swept =
+                        candidate
+                            .lifts
+                            .relax(hyperbolic, SCREEN_EARLY_SWEEPS, RELAX_TOLERANCE);
+                    if swept < SCREEN_EARLY_SWEEPS {
+                        candidate.lifts.rehome(polygon);
+                        let settled = score(&candidate.lifts, positions, areas, hyperbolic);
+                        return Ok(Early::Settled(settled, candidate));
+                    }
+                    let early = score(&candidate.lifts, positions, areas, hyperbolic);
+                    Ok(Early::Going(early.total))
                 }
                 // The searched words are checked as the canonical ones are; should they fail, the
                 // canonical ones still stand.
                 Err(e) if c > 0 => {
                     tracing::debug!(base = systems[s].base, "searched marking dropped: {e}");
-                    Ok(None)
+                    Ok(Early::Failed)
                 }
                 Err(e) => Err(e),
             }
         })
-        .collect::<Result<Vec<Option<f64>>, EmbeddingError>>()?;
+        .collect::<Result<Vec<Early>, EmbeddingError>>()?;
     let best_early = early
         .iter()
-        .flatten()
-        .copied()
+        .filter_map(Early::score)
         .fold(f64::INFINITY, f64::min);
     let (best, k, candidate) = early
         .into_par_iter()
         .enumerate()
         .filter_map(|(k, early)| {
-            let early = early?;
             let (s, _, words) = pairs[k];
             let base = systems[s].base;
+            let early_score = early.score()?;
             // Where no early score is finite, none can be told apart yet: every candidate goes on.
-            let promising = early <= SCREEN_KEEP * best_early || !best_early.is_finite();
+            let promising = early_score <= SCREEN_KEEP * best_early || !best_early.is_finite();
             if !promising {
-                tracing::debug!(base, early, "marking dropped after the early sweeps");
+                tracing::debug!(
+                    base,
+                    early = early_score,
+                    "marking dropped after the early sweeps"
+                );
                 return None;
             }
-            let mut candidate =
-                start_candidate(he, positions, triangles, polygon, &systems[s], words).ok()?;
-            candidate
-                .lifts
-                .relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
-            candidate.lifts.rehome(polygon);
-            let full = score(&candidate.lifts, positions, areas, hyperbolic);
+            let (full, candidate) = match early {
+                Early::Settled(full, candidate) => (full, candidate),
+                _ => {
+                    let mut candidate =
+                        start_candidate(he, positions, triangles, polygon, &systems[s], words)
+                            .ok()?;
+                    candidate
+                        .lifts
+                        .relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
+                    candidate.lifts.rehome(polygon);
+                    (
+                        score(&candidate.lifts, positions, areas, hyperbolic),
+                        candidate,
+                    )
+                }
+            };
             tracing::debug!(
                 base,
-                early,
+                early = early_score,
                 score = full.total,
                 stretch = full.stretch,
                 skew = full.skew,
@@ -1314,6 +1332,26 @@ fn candidates(
         offered.push(displaced);
     }
     Ok((offered, spare))
+}
+
+/// A candidate marking after the screen's early sweeps.
+enum Early {
+    /// Its map settled within them: scored and kept.
+    Settled(Score, Candidate),
+    /// Still moving: its early score.
+    Going(f64),
+    /// Its words made no map (a searched marking; the canonical words' failure is an error).
+    Failed,
+}
+
+impl Early {
+    fn score(&self) -> Option<f64> {
+        match self {
+            Early::Settled(score, _) => Some(score.total),
+            Early::Going(score) => Some(*score),
+            Early::Failed => None,
+        }
+    }
 }
 
 /// A marking's words and the map they define, relaxed.
