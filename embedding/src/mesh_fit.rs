@@ -1141,7 +1141,8 @@ struct Marked {
 /// Every candidate is relaxed for [`SCREEN_EARLY_SWEEPS`] sweeps and scored; those within
 /// [`SCREEN_KEEP`] times the best early score are relaxed for [`SCREEN_SWEEPS`] and scored again,
 /// and the best of those is kept. On the 10 706-vertex genus-4 plate (the `mesh_fit` bench) 5 of
-/// 13 candidates go on and the screen takes 3.0 s where it took 4.4 s; the early scores were
+/// 13 candidates go on and `ntori fit`'s "cutting and flattening" (loops, searches and this
+/// screen) takes 3.0 s where it took 4.4 s; the early scores were
 /// within 1.5 times the final ones there (0.78 against 0.52 at most), within 1e-5 on the smaller
 /// plates, and the kept marking is the same on the plates of genus 2 to 4, the pretzel, the cube
 /// with tunnels and the trefoil tube (`examples/acceptance.rs`: the same distances).
