@@ -127,28 +127,14 @@ fn ratios(genera: &[u32], mesh_resolution: usize) {
     };
     println!("ratios to the baseline (sparse LU of a {BASELINE_SIDE}² grid), measured in turns:");
     for &genus in genera {
-        let (spline, settings) = default_settings(genus);
-        let resolution = default_resolution(genus).unwrap();
         report(&format!("initial_fit/{genus}"), &mut || {
-            drop(initial_model(genus, resolution, spline, settings).unwrap())
+            drop(plate_fit(genus))
         });
     }
     let mesh = HoledMesh::new(4, mesh_resolution).unwrap();
-    let (settings, fit_settings) = mesh_fit::default_settings(4);
     report(
         &format!("mesh_fit/genus4_{}v", mesh.positions.len()),
-        &mut || {
-            drop(
-                mesh_model(
-                    &mesh.positions,
-                    &mesh.triangles,
-                    settings,
-                    fit_settings,
-                    &|_| {},
-                )
-                .unwrap(),
-            )
-        },
+        &mut || drop(genus4_mesh_fit(&mesh)),
     );
 }
 
@@ -157,9 +143,7 @@ fn initial_fit(c: &mut Criterion, genera: &[u32]) {
     group.sample_size(10);
     for &genus in genera {
         group.bench_with_input(BenchmarkId::from_parameter(genus), &genus, |b, &g| {
-            let (spline, settings) = default_settings(g);
-            let resolution = default_resolution(g).unwrap();
-            b.iter(|| initial_model(g, resolution, spline, settings).unwrap())
+            b.iter(|| plate_fit(g))
         });
     }
     group.finish();
@@ -168,25 +152,33 @@ fn initial_fit(c: &mut Criterion, genera: &[u32]) {
 /// The genus-4 plate at `resolution` (34: 10 276 vertices), fitted as a user's mesh.
 fn whole_mesh_fit(c: &mut Criterion, resolution: usize) {
     let mesh = HoledMesh::new(4, resolution).unwrap();
-    let (settings, fit_settings) = mesh_fit::default_settings(4);
     let mut group = c.benchmark_group("mesh_fit");
     group.sample_size(10);
     let id = format!("genus4_{}v", mesh.positions.len());
-    group.bench_function(id, |b| {
-        b.iter(|| {
-            let fit = mesh_model(
-                &mesh.positions,
-                &mesh.triangles,
-                settings,
-                fit_settings,
-                &|_| {},
-            )
-            .unwrap();
-            assert_eq!((fit.genus, fit.parameterization.folded), (4, 0));
-            fit
-        })
-    });
+    group.bench_function(id, |b| b.iter(|| genus4_mesh_fit(&mesh)));
     group.finish();
+}
+
+/// `ntori new`'s fit of its genus-`genus` plate at its default resolution and settings.
+fn plate_fit(genus: u32) -> embedding::fit::InitialFit {
+    let (spline, settings) = default_settings(genus);
+    let resolution = default_resolution(genus).unwrap();
+    initial_model(genus, resolution, spline, settings).unwrap()
+}
+
+/// `ntori fit`'s fit of a genus-4 plate mesh, checked to map without a fold.
+fn genus4_mesh_fit(mesh: &HoledMesh) -> mesh_fit::MeshFit {
+    let (settings, fit_settings) = mesh_fit::default_settings(4);
+    let fit = mesh_model(
+        &mesh.positions,
+        &mesh.triangles,
+        settings,
+        fit_settings,
+        &|_| {},
+    )
+    .unwrap();
+    assert_eq!((fit.genus, fit.parameterization.folded), (4, 0));
+    fit
 }
 
 /// The genus-8 plate at `resolution` (42: 64 k triangles), split 1-to-4 twice (about 10⁶): its

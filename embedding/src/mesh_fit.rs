@@ -1233,19 +1233,8 @@ fn best_marking(
             }
             let (full, candidate) = match early {
                 Early::Settled(full, candidate) => (full, candidate),
-                _ => {
-                    let mut candidate =
-                        start_candidate(he, positions, triangles, polygon, &systems[s], words)
-                            .ok()?;
-                    candidate
-                        .lifts
-                        .relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
-                    candidate.lifts.rehome(polygon);
-                    (
-                        score(&candidate.lifts, positions, areas, hyperbolic),
-                        candidate,
-                    )
-                }
+                _ => relax_candidate(he, positions, triangles, areas, polygon, &systems[s], words)
+                    .ok()?,
             };
             tracing::debug!(
                 base,
@@ -1263,7 +1252,7 @@ fn best_marking(
         .ok_or_else(|| EmbeddingError::Parameterization("no marking's map could be made".into()))?;
     let s = pairs[k].0;
     let marked = candidate.marked(systems.swap_remove(s));
-    let Some(spare) = offered[s].1.clone() else {
+    let Some(spare) = &offered[s].1 else {
         return Ok(marked);
     };
     match relax_candidate(
@@ -1275,7 +1264,12 @@ fn best_marking(
         &marked.system,
         spare,
     ) {
-        Ok((spare_score, candidate)) if spare_score < best.total => {
+        Ok((spare_score, candidate)) if spare_score.total < best.total => {
+            tracing::debug!(
+                base = marked.system.base,
+                score = spare_score.total,
+                "spare marking kept"
+            );
             Ok(candidate.marked(marked.system))
         }
         Ok(_) => Ok(marked),
@@ -1411,8 +1405,8 @@ fn score(lifts: &Lifts, positions: &[Point3], areas: &[f64], hyperbolic: bool) -
     }
 }
 
-/// The map of `words` on `system`'s loops, relaxed for [`SCREEN_SWEEPS`] sweeps, and its score
-/// (see [`score`]).
+/// The map of `words` on `system`'s loops, relaxed for [`SCREEN_SWEEPS`] sweeps (or until it
+/// settles), moved back into the polygon, and its [`score`].
 fn relax_candidate(
     he: &HalfEdgeMesh,
     positions: &[Point3],
@@ -1420,21 +1414,18 @@ fn relax_candidate(
     areas: &[f64],
     polygon: &Polygon,
     system: &LoopSystem,
-    words: Vec<schema::Word>,
-) -> Result<(f64, Candidate), EmbeddingError> {
+    words: &[schema::Word],
+) -> Result<(Score, Candidate), EmbeddingError> {
     let hyperbolic = polygon.geometry() == charts::Geometry::Hyperbolic;
-    let mut candidate = start_candidate(he, positions, triangles, polygon, system, &words)?;
+    let mut candidate = start_candidate(he, positions, triangles, polygon, system, words)?;
     candidate
         .lifts
         .relax(hyperbolic, SCREEN_SWEEPS, RELAX_TOLERANCE);
     candidate.lifts.rehome(polygon);
-    let scored = score(&candidate.lifts, positions, areas, hyperbolic);
-    tracing::debug!(
-        base = system.base,
-        score = scored.total,
-        "spare marking screened"
-    );
-    Ok((scored.total, candidate))
+    Ok((
+        score(&candidate.lifts, positions, areas, hyperbolic),
+        candidate,
+    ))
 }
 
 /// Each generator's loop length on the mesh, in the metric its loop system was grown in: the
