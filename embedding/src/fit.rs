@@ -249,10 +249,10 @@ pub struct FitSettings {
     /// triangles). The plates are even already and ignore it.
     pub even_rounds: usize,
     /// Measure the smoothness term in the surface's own arc length (`bending.rs`), with the metric
-    /// of a first fit (`arc_length_smoothness`, on grids [`FitSettings::metric_coarsening`] times
-    /// coarser). For maps that stretch the surface more one way than the other (a user's tubes
-    /// and limbs), and for `new`'s plates up to genus 15 ([`plate_surface_smoothness`]), whose
-    /// eased rims it smooths.
+    /// of a first fit (on grids [`FitSettings::metric_coarsening`] times coarser, or on the same
+    /// grids; see [`fit`]). For maps that stretch the surface more one way than the other (a
+    /// user's tubes and limbs), and for `new`'s plates up to genus 15
+    /// ([`plate_surface_smoothness`]), whose eased rims it smooths.
     pub surface_smoothness: bool,
     /// How many times coarser (per side) the grids of the first fit that gives the arc-length term
     /// its metric are: 1, the same grids (the metric from the control points' differences); 2,
@@ -2231,10 +2231,28 @@ pub fn fit(
             analysis,
         );
     }
-    // The arc-length rows need a first fit; the normal equations' analysis needs only which
-    // control points the rows reach, which the data rows and the rows' stencils tell: both at once.
+    if settings.metric_coarsening <= 1 {
+        // The first fit is on these grids with the plain rows, whose pattern the analysis holds
+        // too: made on the other core while the first system is formed, it serves both fits,
+        // where the first had analysed its own (`ntori fit` of the genus-4 bench mesh, 10 706
+        // vertices: the fit's stage took 5.5 to 5.9 s, against 6.0 to 6.3 s).
+        let make = || data.analysis(layout);
+        let (control, analysis) = data.solve_keeping(
+            layout,
+            &smoothness_rows(layout),
+            settings.smoothness,
+            Analysis::Alongside(&make),
+        )?;
+        let metrics = crate::bending::grid_metrics(layout, &control);
+        let smooth = crate::bending::arc_length_rows(layout, &metrics);
+        let analysis = analysis.as_ref().map_or(Analysis::Here, Analysis::Ahead);
+        return data.solve(layout, &smooth, settings.smoothness, analysis);
+    }
+    // The arc-length rows need a first fit, here on coarser grids; the normal equations' analysis
+    // needs only which control points the rows reach, which the data rows and the rows' stencils
+    // tell: both at once.
     let (smooth, analysis) = rayon::join(
-        || arc_length_smoothness(layout, &data, points, targets, weights, settings),
+        || coarse_arc_length_smoothness(layout, points, targets, weights, settings),
         || data.analysis(layout),
     );
     // Where the analysis could not be made, the solve makes its own (and reports what fails).
@@ -2243,30 +2261,18 @@ pub fn fit(
 }
 
 /// The smoothness rows in the surface's arc length ([`FitSettings::surface_smoothness`]), with the
-/// metric read off a first fit with the plain rows: on the same grids (through `data`, the fit's
-/// own rows), from its control points' differences, or on grids
-/// [`FitSettings::metric_coarsening`] times coarser, from its patches' derivatives (at genus 10
-/// the full first fit took 1.8 s of the fit's 3.7 s; the coarse one about 0.6 s).
-fn arc_length_smoothness(
+/// metric read off a first fit with the plain rows on grids [`FitSettings::metric_coarsening`]
+/// times coarser, from its patches' derivatives (at genus 10 the first fit on the full grids took
+/// 1.8 s of the fit's 3.7 s; the coarse one about 0.6 s).
+fn coarse_arc_length_smoothness(
     layout: &Layout,
-    data: &DataRows,
     points: &[ChartPoint],
     targets: &[Point3],
     weights: &[f64],
     settings: FitSettings,
 ) -> Result<Vec<Vec<(usize, f64)>>, EmbeddingError> {
     let fine = layout.settings();
-    let coarsening = settings.metric_coarsening.max(1);
-    if coarsening == 1 {
-        let control = data.solve(
-            layout,
-            &smoothness_rows(layout),
-            settings.smoothness,
-            Analysis::Here,
-        )?;
-        let metrics = crate::bending::grid_metrics(layout, &control);
-        return Ok(crate::bending::arc_length_rows(layout, &metrics));
-    }
+    let coarsening = settings.metric_coarsening;
     let coarser = |g: usize| (g / coarsening).max(fine.degree + 2);
     let coarse = SplineSettings {
         grid: coarser(fine.grid),
@@ -2427,9 +2433,22 @@ impl DataRows {
         smoothness: f64,
         analysis: Analysis<'_>,
     ) -> Result<Vec<Point3>, EmbeddingError> {
+        Ok(self.solve_keeping(layout, smooth, smoothness, analysis)?.0)
+    }
+
+    /// As [`DataRows::solve`], also returning the normal equations' analysis where `analysis`
+    /// asked for one to be made alongside.
+    fn solve_keeping(
+        &self,
+        layout: &Layout,
+        smooth: &[Vec<(usize, f64)>],
+        smoothness: f64,
+        analysis: Analysis<'_>,
+    ) -> Result<(Vec<Point3>, Option<NormalAnalysis>), EmbeddingError> {
         let (rows, triplets, rhs) = self.with_smoothness(smooth, smoothness);
-        let x = LeastSquares::new(rows, layout.control_count(), &triplets, analysis)?.solve(&rhs);
-        control_points(&x, smoothness)
+        let system = LeastSquares::new(rows, layout.control_count(), &triplets, analysis)?;
+        let x = system.solve(&rhs);
+        Ok((control_points(&x, smoothness)?, system.into_analysis()))
     }
 
     /// The normal equations' analysis for these rows with any smoothness rows whose each row
@@ -2672,9 +2691,11 @@ mod tests {
     }
 
     /// The analysis the fit makes ahead from the data rows and the smoothness stencils holds
-    /// the whole system's AᵀA, with the plain rows and with the arc-length rows, on the plates
-    /// and grids `new` uses for genus 2, 5, 8 and 12 (else the fit would analyse it again
-    /// and lose the time the analysis saves).
+    /// the whole system's AᵀA, with the plain rows and with the arc-length rows (their metric
+    /// from a coarse first fit, as `new`'s plates take it, and from a first fit on the same
+    /// grids, as a user's mesh does, where one analysis serves both fits), on the plates and
+    /// grids `new` uses for genus 2, 5, 8 and 12 (else the fit would analyse it again and lose
+    /// the time the analysis saves).
     #[test]
     fn the_analysis_made_ahead_holds_the_fit_s_systems() {
         for genus in [2, 5, 8, 12] {
@@ -2691,11 +2712,20 @@ mod tests {
                 surface_smoothness: true,
                 ..settings
             };
-            let arc_rows =
-                arc_length_smoothness(&layout, &data, points, targets, &weights, arc).unwrap();
+            let coarse_rows =
+                coarse_arc_length_smoothness(&layout, points, targets, &weights, arc).unwrap();
+            let plain = smoothness_rows(&layout);
+            let first = data
+                .solve(&layout, &plain, settings.smoothness, Analysis::Here)
+                .unwrap();
+            let grid_rows = crate::bending::arc_length_rows(
+                &layout,
+                &crate::bending::grid_metrics(&layout, &first),
+            );
             for (name, smooth) in [
-                ("plain", smoothness_rows(&layout)),
-                ("arc length", arc_rows),
+                ("plain", plain),
+                ("arc length, coarse metric", coarse_rows),
+                ("arc length, grid metric", grid_rows),
             ] {
                 let (rows, triplets, _) = data.with_smoothness(&smooth, settings.smoothness);
                 let formed =

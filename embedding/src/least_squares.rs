@@ -21,6 +21,8 @@ pub(crate) struct LeastSquares {
     factor: Llt<usize, f64>,
     /// ε² where AᵀA was singular (then the factor is of AᵀA + ε² I), else 0.
     ridge: f64,
+    /// The analysis made alongside ([`Analysis::Alongside`]), for a later system within it.
+    made_alongside: Option<NormalAnalysis>,
 }
 
 /// The solver's error for `rows` × `cols`, naming what failed.
@@ -352,7 +354,14 @@ impl LeastSquares {
             at,
             factor,
             ridge,
+            made_alongside: alongside,
         })
+    }
+
+    /// The analysis made alongside this system's forming, where one was asked for and made: a
+    /// later system whose rows stay within its pattern need not be analysed again.
+    pub(crate) fn into_analysis(self) -> Option<NormalAnalysis> {
+        self.made_alongside
     }
 
     /// The least-squares solution for `rhs` (one column per coordinate): the corrected seminormal
@@ -493,11 +502,19 @@ mod tests {
                 .unwrap()
                 .solve(&rhs);
             let make = || NormalAnalysis::new(rows + 40, cols, entries());
-            let alongside = LeastSquares::new(rows, cols, &triplets, Analysis::Alongside(&make))
-                .unwrap()
-                .solve(&rhs);
+            let system = LeastSquares::new(rows, cols, &triplets, Analysis::Alongside(&make));
+            let system = system.unwrap();
+            let alongside = system.solve(&rhs);
             assert!((&here - &ahead).norm_max() < 1e-12, "seed {seed}");
             assert!((&here - &alongside).norm_max() < 1e-12, "seed {seed}");
+            // The analysis made alongside comes back out and serves the same system again.
+            let kept = system.into_analysis().expect("the analysis made alongside");
+            let again = LeastSquares::new(rows, cols, &triplets, Analysis::Ahead(&kept))
+                .unwrap()
+                .solve(&rhs);
+            assert!((&here - &again).norm_max() < 1e-12, "seed {seed}");
+            let plain = LeastSquares::new(rows, cols, &triplets, Analysis::Here).unwrap();
+            assert!(plain.into_analysis().is_none(), "seed {seed}");
             if seed % 2 == 0 {
                 assert!(ahead.row(7).norm_max() < 1e-12, "seed {seed}");
             }
