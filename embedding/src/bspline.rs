@@ -187,33 +187,34 @@ fn cubic(t: f64) -> [[f64; 4]; 4] {
     ]
 }
 
-/// [`UniformBasis::eval`]'s table at local parameter t of a span, knot spacing h.
+/// [`UniformBasis::eval`]'s table at local parameter t of a span, knot spacing h: the table on
+/// unit knots, the d-th derivatives scaled by h⁻ᵈ.
 fn span_table<const P: usize>(t: f64, derivs: usize, h: f64) -> [[f64; MAX_DEGREE + 1]; 4] {
-    if P == 3 {
-        let rows = cubic(t);
-        let mut out = [[0.0; MAX_DEGREE + 1]; 4];
-        let mut scale = 1.0;
-        for (d, row) in out.iter_mut().enumerate().take(derivs + 1) {
-            for (v, r) in row.iter_mut().zip(rows[d]) {
-                *v = scale * r;
-            }
-            scale /= h;
-        }
-        return out;
-    }
-    recurrence_table::<P>(t, derivs, h)
-}
-
-/// [`span_table`] by the recurrence, for any degree.
-fn recurrence_table<const P: usize>(t: f64, derivs: usize, h: f64) -> [[f64; MAX_DEGREE + 1]; 4] {
-    let levels = unit_triangle_of::<P>(t);
+    let unit = if P == 3 {
+        cubic(t).map(|[a, b, c, d]| [a, b, c, d, 0.0, 0.0, 0.0, 0.0])
+    } else {
+        recurrence_table::<P>(t)
+    };
     let mut out = [[0.0; MAX_DEGREE + 1]; 4];
     let mut scale = 1.0;
-    for (d, row) in out.iter_mut().enumerate().take(derivs + 1) {
-        for (j, v) in row.iter_mut().enumerate().take(P + 1) {
-            *v = scale * difference(&levels[P - d], d, j);
+    for (row, unit_row) in out.iter_mut().zip(unit).take(derivs + 1) {
+        for (v, u) in row.iter_mut().zip(unit_row).take(P + 1) {
+            *v = scale * u;
         }
         scale /= h;
+    }
+    out
+}
+
+/// The table on unit knots of [`span_table`] by the recurrence, for any degree: the values and
+/// their first to third derivatives (rows past the degree are zero).
+fn recurrence_table<const P: usize>(t: f64) -> [[f64; MAX_DEGREE + 1]; 4] {
+    let levels = unit_triangle_of::<P>(t);
+    let mut out = [[0.0; MAX_DEGREE + 1]; 4];
+    for (d, row) in out.iter_mut().enumerate().take(P.min(3) + 1) {
+        for (j, v) in row.iter_mut().enumerate().take(P + 1) {
+            *v = difference(&levels[P - d], d, j);
+        }
     }
     out
 }
@@ -270,22 +271,26 @@ pub fn cardinal(d: usize, x: f64) -> [f64; 4] {
     if !(0.0..n).contains(&y) {
         return out;
     }
-    // On the span [m, m + 1) the bump N_d is the degree-d function starting at 0, index d − m.
+    // On the span [m, m + 1) the bump N_d is the degree-d function starting at 0, index d − m:
+    // its value and derivatives on unit knots, then scaled by n per order.
     let m = y as usize;
     let t = y - m as f64;
-    if d == 3 {
-        let rows = cubic(t);
-        let mut scale = 1.0;
-        for (o, row) in out.iter_mut().zip(rows) {
-            *o = scale * row[3 - m];
-            scale *= n;
-        }
-        return out;
-    }
-    let levels = unit_triangle(d, t);
+    let orders = d.min(3) + 1;
+    let unit: [f64; 4] = if d == 3 {
+        cubic(t).map(|row| row[3 - m])
+    } else {
+        let levels = unit_triangle(d, t);
+        std::array::from_fn(|r| {
+            if r < orders {
+                difference(&levels[d - r], r, d - m)
+            } else {
+                0.0
+            }
+        })
+    };
     let mut scale = 1.0;
-    for (r, o) in out.iter_mut().enumerate().take(d.min(3) + 1) {
-        *o = scale * difference(&levels[d - r], r, d - m);
+    for (o, u) in out.iter_mut().zip(unit).take(orders) {
+        *o = scale * u;
         scale *= n;
     }
     out
@@ -446,11 +451,14 @@ mod tests {
         #[test]
         fn the_cubic_is_the_recurrence_to_the_bit(t in 0.0f64..1.0, h in 0.001f64..1.0) {
             let fast = span_table::<3>(t, 3, h);
-            let slow = recurrence_table::<3>(t, 3, h);
+            let unit = recurrence_table::<3>(t);
+            let mut scale = 1.0;
             for d in 0..4 {
                 for j in 0..4 {
-                    prop_assert_eq!(fast[d][j].to_bits(), slow[d][j].to_bits(), "d {} j {}", d, j);
+                    let slow = scale * unit[d][j];
+                    prop_assert_eq!(fast[d][j].to_bits(), slow.to_bits(), "d {} j {}", d, j);
                 }
+                scale /= h;
             }
             prop_assert_eq!(unit_values(3, t), unit_values_of::<3>(t));
             for m in 0..4 {
