@@ -47,7 +47,9 @@ pub use model::{
     DISK_GRID_VERSION, MODEL_FORMAT, MODEL_VERSION, Model, ModelHeader, ModelPin, PINS_VERSION,
 };
 pub use spline_surface::{ControlId, Surface};
-pub use stencil::{ColumnIndex, ControlFrame, Stencil, TensorStencil, tangent_words};
+pub use stencil::{
+    ColumnIndex, ControlFrame, Stencil, StencilKernel, TensorStencil, tangent_words,
+};
 pub use surface::{
     ControlGrids, Jet, Layout, Point3, SplineSettings, SurfaceJet, Vector3, Weight, bounding_box,
 };

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use charts::{Atlas, ChartId, ChartPoint};
 use embedding::bspline::UniformBasis;
-use embedding::{Layout, Model, Point3, SplineSettings, Stencil, Vector3};
+use embedding::{Layout, Model, Point3, SplineSettings, Stencil, StencilKernel, Vector3};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use proptest::prelude::*;
@@ -1089,38 +1089,58 @@ fn stencils_give_the_same_numbers_on_all_cores() {
     assert_eq!(one, all, "tangents, rows alone, rows followed");
 }
 
-/// Where the cubic kernel with AVX and FMA runs, the portable kernel gives the same positions to
-/// rounding (and both match the f64 stencil); elsewhere the two are one kernel.
+/// Every kernel this CPU runs (the portable one, AVX with FMA, AVX-512) gives the f64 stencil's
+/// positions to 1e-6 of the diagonal, and the same as the portable kernel to rounding.
 #[test]
-fn the_cubic_simd_kernel_agrees_with_the_portable_one() {
+fn every_kernel_gives_the_f64_stencil_s_positions() {
+    let kernels: Vec<StencilKernel> = StencilKernel::ALL
+        .into_iter()
+        .filter(|k| k.available())
+        .collect();
+    assert_eq!(kernels.last(), Some(&StencilKernel::fastest()));
     for genus in [0, 2, 5] {
         let atlas = atlas(genus);
         let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
         let control = noisy_controls(&layout, 5);
         let points = atlas.tessellate(12, 9).unwrap().vertices;
         let tensor = embedding::TensorStencil::build(&layout, &points);
-        let (mut fast, mut portable, mut exact) = (
-            vec![Point3::origin(); points.len()],
-            vec![Point3::origin(); points.len()],
-            vec![Point3::origin(); points.len()],
-        );
-        tensor.positions(&control, &mut fast);
-        tensor.positions_portable(&control, &mut portable);
+        let mut exact = vec![Point3::origin(); points.len()];
         Stencil::build(&layout, &points).positions(&control, &mut exact);
         let (lo, hi) = embedding::bounding_box(&exact);
         let diagonal = (hi - lo).norm();
-        for ((a, b), c) in fast.iter().zip(&portable).zip(&exact) {
-            assert!((a - b).norm() <= 1e-6 * diagonal, "genus {genus}");
-            assert!((a - c).norm() <= 1e-6 * diagonal, "genus {genus}");
+        let by = |kernel| {
+            let mut out = vec![Point3::origin(); points.len()];
+            tensor.positions_by(kernel, &control, &mut out);
+            out
+        };
+        let portable = by(StencilKernel::Portable);
+        for &kernel in &kernels {
+            let out = by(kernel);
+            for ((a, b), c) in out.iter().zip(&portable).zip(&exact) {
+                assert!(
+                    (a - b).norm() <= 1e-6 * diagonal,
+                    "genus {genus}, {kernel:?}"
+                );
+                assert!(
+                    (a - c).norm() <= 1e-6 * diagonal,
+                    "genus {genus}, {kernel:?}"
+                );
+            }
         }
+        let mut fastest = vec![Point3::origin(); points.len()];
+        tensor.positions(&control, &mut fastest);
+        assert_eq!(
+            fastest,
+            by(StencilKernel::fastest()),
+            "positions runs the fastest"
+        );
     }
 }
 
-/// Where the cubic tangent kernel with AVX and FMA runs, the portable one gives the same positions
-/// and tangents to rounding (1e-6 of the diagonal, 1e-6 of the largest tangent); elsewhere the two
-/// are one kernel.
+/// Every kernel this CPU runs gives the portable kernel's positions and tangents to rounding (1e-6
+/// of the diagonal, 1e-6 of the largest tangent), and `positions_and_tangents` runs the fastest.
 #[test]
-fn the_cubic_simd_tangent_kernel_agrees_with_the_portable_one() {
+fn every_tangent_kernel_agrees_with_the_portable_one() {
     for genus in [0, 2, 5] {
         let atlas = atlas(genus);
         let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
@@ -1128,12 +1148,12 @@ fn the_cubic_simd_tangent_kernel_agrees_with_the_portable_one() {
         let points = atlas.tessellate(12, 9).unwrap().vertices;
         let tensor = embedding::TensorStencil::build_with_tangents(&layout, &points);
         let n = points.len();
-        let (mut fast, mut portable) = (
-            (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]),
-            (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]),
-        );
-        tensor.positions_and_tangents(&control, &mut fast.0, &mut fast.1);
-        tensor.positions_and_tangents_portable(&control, &mut portable.0, &mut portable.1);
+        let by = |kernel| {
+            let mut out = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
+            tensor.positions_and_tangents_by(kernel, &control, &mut out.0, &mut out.1);
+            out
+        };
+        let portable = by(StencilKernel::Portable);
         let (lo, hi) = embedding::bounding_box(&portable.0);
         let diagonal = (hi - lo).norm();
         let largest = portable
@@ -1142,15 +1162,24 @@ fn the_cubic_simd_tangent_kernel_agrees_with_the_portable_one() {
             .flatten()
             .map(|t| t.norm())
             .fold(0.0, f64::max);
-        for r in 0..n {
-            assert!(
-                (fast.0[r] - portable.0[r]).norm() <= 1e-6 * diagonal,
-                "genus {genus}"
-            );
-            for k in 0..2 {
-                let off = (fast.1[r][k] - portable.1[r][k]).norm();
-                assert!(off <= 1e-6 * largest, "genus {genus}, row {r}: {off:e}");
+        for kernel in StencilKernel::ALL.into_iter().filter(|k| k.available()) {
+            let fast = by(kernel);
+            for r in 0..n {
+                assert!(
+                    (fast.0[r] - portable.0[r]).norm() <= 1e-6 * diagonal,
+                    "genus {genus}, {kernel:?}"
+                );
+                for k in 0..2 {
+                    let off = (fast.1[r][k] - portable.1[r][k]).norm();
+                    assert!(
+                        off <= 1e-6 * largest,
+                        "genus {genus}, {kernel:?}, row {r}: {off:e}"
+                    );
+                }
             }
         }
+        let mut fastest = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
+        tensor.positions_and_tangents(&control, &mut fastest.0, &mut fastest.1);
+        assert_eq!(fastest, by(StencilKernel::fastest()), "the fastest runs");
     }
 }

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use charts::{Atlas, ChartPoint};
 use embedding::edit::{Constraint, RefreshScratch, refresh, solve};
-use embedding::{Layout, Point3, SplineSettings, Stencil, TensorStencil, Vector3};
+use embedding::{Layout, Point3, SplineSettings, Stencil, StencilKernel, TensorStencil, Vector3};
 use serde::Serialize;
 
 use super::{GenusArg, spinner, write_stdout};
@@ -272,9 +272,14 @@ pub fn measure(
         "vertices",
         bytes,
     );
-    // The same without the cubic AVX/FMA kernel (where it runs), for the ratio between the two.
+    // The same by the portable kernel (not the cubic AVX or AVX-512 one), for the ratio.
     let secs = best_of(5, || {
-        framed.positions_and_tangents_portable(black_box(&control), &mut out, &mut tangents)
+        framed.positions_and_tangents_by(
+            StencilKernel::Portable,
+            black_box(&control),
+            &mut out,
+            &mut tangents,
+        )
     });
     add(
         "reembed_tangents_portable",

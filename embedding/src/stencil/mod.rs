@@ -11,7 +11,9 @@
 
 mod tensor;
 
-pub use tensor::{ControlFrame, Followed, NEGLIGIBLE_BLEND, TensorStencil, tangent_words};
+pub use tensor::{
+    ControlFrame, Followed, NEGLIGIBLE_BLEND, StencilKernel, TensorStencil, tangent_words,
+};
 
 use charts::ChartPoint;
 

@@ -58,6 +58,57 @@ const FRAME_NS: usize = 50;
 const BUILD_NS: usize = 500;
 const FOLLOW_NS: usize = 10;
 
+/// Which code sums a cubic stencil's rows. Each gives the same positions to rounding (tested
+/// against the f64 stencil); stencils of other orders always take [`StencilKernel::Portable`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StencilKernel {
+    /// Plain Rust over glam's four-lane vectors: any CPU, any order.
+    Portable,
+    /// 256-bit registers and fused multiply-adds (x86-64 with AVX and FMA): two control points
+    /// (x, y, z, 0) per register.
+    Avx,
+    /// 512-bit registers (x86-64 with AVX-512F): a cubic block's whole line, its four control
+    /// points, per register, so half the loads and multiply-adds of [`StencilKernel::Avx`].
+    Avx512,
+}
+
+impl StencilKernel {
+    /// Every kernel, slowest first.
+    pub const ALL: [StencilKernel; 3] = [
+        StencilKernel::Portable,
+        StencilKernel::Avx,
+        StencilKernel::Avx512,
+    ];
+
+    /// Whether this CPU runs it.
+    pub fn available(self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        let wide = |k: StencilKernel| match k {
+            StencilKernel::Portable => true,
+            StencilKernel::Avx => {
+                is_x86_feature_detected!("avx") && is_x86_feature_detected!("fma")
+            }
+            StencilKernel::Avx512 => {
+                is_x86_feature_detected!("avx512f")
+                    && is_x86_feature_detected!("avx")
+                    && is_x86_feature_detected!("fma")
+            }
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let wide = |k: StencilKernel| k == StencilKernel::Portable;
+        wide(self)
+    }
+
+    /// The fastest kernel this CPU runs (the widest registers it has).
+    pub fn fastest() -> StencilKernel {
+        *StencilKernel::ALL
+            .iter()
+            .rev()
+            .find(|k| k.available())
+            .unwrap_or(&StencilKernel::Portable)
+    }
+}
+
 /// Positions = W · control points for a fixed set of surface points, W stored chart by chart in
 /// tensor form (see the module's comment).
 #[derive(Clone, Debug, Default)]
@@ -302,19 +353,28 @@ impl TensorStencil {
         self.frames_into(&frame, 0, &mut positions[..rows], &mut tangents[..rows]);
     }
 
-    /// [`TensorStencil::positions_and_tangents`] by the portable kernel alone, even where the cubic
-    /// one with AVX and FMA would run: for tests and benches that compare the two.
-    #[doc(hidden)]
-    pub fn positions_and_tangents_portable(
+    /// [`TensorStencil::positions_and_tangents`] by `kernel`, for tests and benches that compare
+    /// the kernels.
+    ///
+    /// # Panics
+    /// If the stencil was built without tangents, or this CPU does not run `kernel`.
+    pub fn positions_and_tangents_by(
         &self,
+        kernel: StencilKernel,
         control: &[Point3],
         positions: &mut [Point3],
         tangents: &mut [[Vector3; 2]],
     ) {
-        assert!(self.has_tangents(), "a tensor stencil built with tangents");
+        assert!(kernel.available(), "{kernel:?} runs on this CPU");
         let frame = ControlFrame::new(control);
         let rows = self.rows();
-        self.portable_frames_into(&frame, 0, &mut positions[..rows], &mut tangents[..rows]);
+        self.frames_by(
+            kernel,
+            &frame,
+            0,
+            &mut positions[..rows],
+            &mut tangents[..rows],
+        );
     }
 
     /// [`TensorStencil::positions_and_tangents`] on all cores (the same numbers).
@@ -344,11 +404,43 @@ impl TensorStencil {
         positions: &mut [Point3],
         tangents: &mut [[Vector3; 2]],
     ) {
+        self.frames_by(
+            StencilKernel::fastest(),
+            frame,
+            first_row,
+            positions,
+            tangents,
+        );
+    }
+
+    /// [`TensorStencil::frames_into`] by `kernel`, which this CPU must run.
+    fn frames_by(
+        &self,
+        kernel: StencilKernel,
+        frame: &ControlFrame,
+        first_row: usize,
+        positions: &mut [Point3],
+        tangents: &mut [[Vector3; 2]],
+    ) {
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
         #[cfg(target_arch = "x86_64")]
-        if self.order == 4 && simd::available() {
-            // SAFETY: the CPU has AVX and FMA (checked just now).
-            return unsafe { simd::cubic_jets(self, frame, first_row, positions, tangents) };
+        if self.order == 4 {
+            match kernel {
+                // SAFETY: the CPU runs `kernel` (the callers' choice: `StencilKernel::fastest`, or
+                // asserted available).
+                StencilKernel::Avx512 => {
+                    return unsafe {
+                        simd::cubic_jets_wide(self, frame, first_row, positions, tangents)
+                    };
+                }
+                // SAFETY: as above.
+                StencilKernel::Avx => {
+                    return unsafe {
+                        simd::cubic_jets(self, frame, first_row, positions, tangents)
+                    };
+                }
+                StencilKernel::Portable => {}
+            }
         }
         self.portable_frames_into(frame, first_row, positions, tangents);
     }
@@ -532,17 +624,15 @@ impl TensorStencil {
         }
     }
 
-    /// One row of [`TensorStencil::tangent_kernel`] (by the cubic AVX kernel where it runs).
+    /// One row of [`TensorStencil::tangent_kernel`] (by the fastest cubic kernel where it runs).
     fn row_jet<const O: usize>(&self, frame: &ControlFrame, r: usize) -> (Point3, [Vector3; 2]) {
         let mut position = [Point3::origin()];
         let mut tangents = [[Vector3::zeros(); 2]];
-        #[cfg(target_arch = "x86_64")]
-        if O == 4 && simd::available() {
-            // SAFETY: the CPU has AVX and FMA (checked just now).
-            unsafe { simd::cubic_jets(self, frame, r, &mut position, &mut tangents) };
-            return (position[0], tangents[0]);
+        if O == 4 {
+            self.frames_into(frame, r, &mut position, &mut tangents);
+        } else {
+            self.tangent_kernel::<O>(frame, r, &mut position, &mut tangents);
         }
-        self.tangent_kernel::<O>(frame, r, &mut position, &mut tangents);
         (position[0], tangents[0])
     }
 
@@ -595,22 +685,45 @@ impl TensorStencil {
         }
     }
 
-    /// Rows `first_row..first_row + out.len()`, by a copy of the kernel for this order.
+    /// Rows `first_row..first_row + out.len()`, by the fastest kernel for this order.
     fn rows_into(&self, frame: &ControlFrame, first_row: usize, out: &mut [Point3]) {
+        self.rows_by(StencilKernel::fastest(), frame, first_row, out);
+    }
+
+    /// [`TensorStencil::rows_into`] by `kernel`, which this CPU must run.
+    fn rows_by(
+        &self,
+        kernel: StencilKernel,
+        frame: &ControlFrame,
+        first_row: usize,
+        out: &mut [Point3],
+    ) {
         #[cfg(target_arch = "x86_64")]
-        if self.order == 4 && simd::available() {
-            // SAFETY: the CPU has AVX and FMA (checked just now).
-            return unsafe { simd::cubic_rows(self, frame, first_row, out) };
+        if self.order == 4 {
+            match kernel {
+                // SAFETY: the CPU runs `kernel` (the callers' choice: `StencilKernel::fastest`, or
+                // asserted available).
+                StencilKernel::Avx512 => {
+                    return unsafe { simd::cubic_rows_wide(self, frame, first_row, out) };
+                }
+                // SAFETY: as above.
+                StencilKernel::Avx => {
+                    return unsafe { simd::cubic_rows(self, frame, first_row, out) };
+                }
+                StencilKernel::Portable => {}
+            }
         }
         self.portable_rows(frame, first_row, out);
     }
 
-    /// [`TensorStencil::positions`] by the portable kernel alone, even where the cubic one with AVX
-    /// and FMA would run: for tests that compare the two.
-    #[doc(hidden)]
-    pub fn positions_portable(&self, control: &[Point3], out: &mut [Point3]) {
+    /// [`TensorStencil::positions`] by `kernel`, for tests and benches that compare the kernels.
+    ///
+    /// # Panics
+    /// If this CPU does not run `kernel`.
+    pub fn positions_by(&self, kernel: StencilKernel, control: &[Point3], out: &mut [Point3]) {
+        assert!(kernel.available(), "{kernel:?} runs on this CPU");
         let frame = ControlFrame::new(control);
-        self.portable_rows(&frame, 0, &mut out[..self.rows()]);
+        self.rows_by(kernel, &frame, 0, &mut out[..self.rows()]);
     }
 
     /// What [`TensorStencil::positions`] moves, without its arithmetic: each row's start, its
@@ -677,17 +790,14 @@ impl TensorStencil {
     }
 }
 
-/// The cubic kernel with 256-bit registers: two control points (x, y, z, 0) per register, and
-/// fused multiply-adds. About half the instructions of the portable kernel per block.
+/// The cubic kernels: with 256-bit registers, two control points (x, y, z, 0) per register and
+/// fused multiply-adds, about half the instructions of the portable kernel per block; with 512-bit
+/// registers a whole line of a block, four control points, per register, half as many again.
 #[cfg(target_arch = "x86_64")]
 mod simd {
     use std::arch::x86_64::*;
 
     use super::{ControlFrame, PREFETCH_BLOCKS, Point3, TensorStencil, Vector3};
-
-    pub(super) fn available() -> bool {
-        is_x86_feature_detected!("avx") && is_x86_feature_detected!("fma")
-    }
 
     /// Rows `first_row..first_row + out.len()` of a cubic (order 4) stencil.
     #[target_feature(enable = "avx,fma")]
@@ -711,11 +821,7 @@ mod simd {
                     lines.block(f.try_into().expect("cubic factors"), first as usize),
                 );
             }
-            let mut lanes = [0f32; 4];
-            // SAFETY: `lanes` holds the 4 floats stored.
-            unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), acc) };
-            let [x, y, z, _] = lanes.map(f64::from);
-            *o = frame.centre + Vector3::new(x, y, z);
+            *o = frame.centre + widen(acc);
         }
     }
 
@@ -751,11 +857,7 @@ mod simd {
         #[target_feature(enable = "avx")]
         #[inline]
         fn lines(&self, first: usize) -> [(__m256, __m256); 4] {
-            let grid = if first < self.disk_points {
-                self.disk
-            } else {
-                self.square
-            };
+            let grid = self.stride(first);
             std::array::from_fn(|j| {
                 // SAFETY: a block's lines lie inside the grids, which `frame.points` covers
                 // (asserted in `new`): 16 contiguous f32 from `first + j·grid`, read as floats
@@ -765,6 +867,62 @@ mod simd {
                     (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8)))
                 }
             })
+        }
+
+        /// The chart's grid for a block starting at control point `first` (`ControlGrids::stride`,
+        /// its bound hoisted into `disk_points`).
+        #[inline]
+        fn stride(&self, first: usize) -> usize {
+            if first < self.disk_points {
+                self.disk
+            } else {
+                self.square
+            }
+        }
+
+        /// The 4 lines of the block whose first control point is `first`, a line's four points
+        /// (x, y, z, 0) per register.
+        #[target_feature(enable = "avx512f")]
+        #[inline]
+        fn wide_lines(&self, first: usize) -> [__m512; 4] {
+            let grid = self.stride(first);
+            std::array::from_fn(|j| {
+                // SAFETY: as in `lines`: the 16 contiguous f32 from `first + j·grid`.
+                unsafe { _mm512_loadu_ps(self.points.add(4 * (first + j * grid))) }
+            })
+        }
+
+        /// `acc` plus the cubic block with factors `f` whose first control point is `first`,
+        /// the lanes of control point i holding N_i(u) Σ_j β N_j(v) c_ij. The lines' products
+        /// run in two chains of two, so they do not wait on one another.
+        #[target_feature(enable = "avx512f,avx,fma")]
+        #[inline]
+        fn wide_block(&self, f: &[f32; 8], first: usize, acc: __m512) -> __m512 {
+            let [l0, l1, l2, l3] = self.wide_lines(first);
+            let v = |j: usize| _mm512_set1_ps(f[4 + j]);
+            let even = _mm512_fmadd_ps(l2, v(2), _mm512_mul_ps(l0, v(0)));
+            let odd = _mm512_fmadd_ps(l3, v(3), _mm512_mul_ps(l1, v(1)));
+            let u = spread_wide(f[..4].try_into().expect("4 factors"));
+            _mm512_fmadd_ps(_mm512_add_ps(even, odd), u, acc)
+        }
+
+        /// [`Lines::jet_block`]'s three sums with 512-bit registers, control point i's terms in
+        /// its lanes, to be summed at the row's end.
+        #[target_feature(enable = "avx512f,avx,fma")]
+        #[inline]
+        fn wide_jet_block(&self, f: &[f32; 8], d: &[f32; 12], first: usize) -> [__m512; 3] {
+            let (mut v, mut dv) = (_mm512_setzero_ps(), _mm512_setzero_ps());
+            for (j, line) in self.wide_lines(first).into_iter().enumerate() {
+                v = _mm512_fmadd_ps(line, _mm512_set1_ps(f[4 + j]), v);
+                dv = _mm512_fmadd_ps(line, _mm512_set1_ps(d[4 + j]), dv);
+            }
+            let u = spread_wide(f[..4].try_into().expect("4 factors"));
+            let du = spread_wide(d[..4].try_into().expect("4 factors"));
+            [
+                _mm512_mul_ps(v, u),
+                _mm512_mul_ps(v, du),
+                _mm512_mul_ps(dv, u),
+            ]
         }
 
         /// Σ_j β N_j(v) Σ_i N_i(u) c_ij of the cubic block with factors `f` whose first control
@@ -811,6 +969,68 @@ mod simd {
         }
     }
 
+    /// [`cubic_rows`] with 512-bit registers: a block's line, its four control points, in one.
+    /// The lanes of control point i hold N_i(u) Σ_j β N_j(v) c_ij and are summed over i once, at
+    /// the row's end.
+    #[target_feature(enable = "avx512f,avx,fma")]
+    pub(super) fn cubic_rows_wide(
+        stencil: &TensorStencil,
+        frame: &ControlFrame,
+        first_row: usize,
+        out: &mut [Point3],
+    ) {
+        let lines = Lines::new(stencil, frame);
+        let starts = &stencil.row_starts[first_row..=first_row + out.len()];
+        for (o, span) in out.iter_mut().zip(starts.windows(2)) {
+            let blocks = span[0] as usize..span[1] as usize;
+            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
+            let mut acc = _mm512_setzero_ps();
+            for (f, &first) in factors.zip(&stencil.firsts[blocks]) {
+                // Never faults, even past the end.
+                _mm_prefetch::<_MM_HINT_T0>(f.as_ptr().wrapping_add(8 * PREFETCH_BLOCKS).cast());
+                acc = lines.wide_block(f.try_into().expect("cubic factors"), first as usize, acc);
+            }
+            *o = frame.centre + widen(quarters(acc));
+        }
+    }
+
+    /// [`cubic_jets`] with 512-bit registers, as [`cubic_rows_wide`].
+    #[target_feature(enable = "avx512f,avx,fma")]
+    pub(super) fn cubic_jets_wide(
+        stencil: &TensorStencil,
+        frame: &ControlFrame,
+        first_row: usize,
+        positions: &mut [Point3],
+        tangents: &mut [[Vector3; 2]],
+    ) {
+        let lines = Lines::new(stencil, frame);
+        let starts = &stencil.row_starts[first_row..=first_row + positions.len()];
+        for ((o, t), span) in positions.iter_mut().zip(tangents).zip(starts.windows(2)) {
+            let blocks = span[0] as usize..span[1] as usize;
+            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
+            let derivatives =
+                stencil.tangent_factors[12 * blocks.start..12 * blocks.end].chunks_exact(12);
+            let zero = _mm512_setzero_ps();
+            let (mut p, mut su, mut sv) = (zero, zero, zero);
+            for ((f, d), &first) in factors.zip(derivatives).zip(&stencil.firsts[blocks]) {
+                let d: &[f32; 12] = d.try_into().expect("cubic tangent factors");
+                let [a, b, c] =
+                    lines.wide_jet_block(f.try_into().expect("cubic factors"), d, first as usize);
+                let (gu, gv) = (_mm512_set1_ps(d[8]), _mm512_set1_ps(d[9]));
+                let (re, im) = (_mm512_set1_ps(d[10]), _mm512_set1_ps(d[11]));
+                p = _mm512_add_ps(p, a);
+                su = _mm512_fmadd_ps(a, gu, su);
+                su = _mm512_fmadd_ps(b, re, su);
+                su = _mm512_fmadd_ps(c, im, su);
+                sv = _mm512_fmadd_ps(a, gv, sv);
+                sv = _mm512_fnmadd_ps(b, im, sv);
+                sv = _mm512_fmadd_ps(c, re, sv);
+            }
+            *o = frame.centre + widen(quarters(p));
+            *t = [widen(quarters(su)), widen(quarters(sv))];
+        }
+    }
+
     /// Positions and tangents of rows `first_row..first_row + positions.len()` of a cubic stencil
     /// built with tangents: the portable tangent kernel's sums, two control points per 256-bit
     /// register, along v first as in [`cubic_rows`]. Every step after the first products is
@@ -850,16 +1070,50 @@ mod simd {
                 sv = _mm256_fmadd_ps(c, re, sv);
             }
             let wide = |v: __m256| {
-                let sum = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
-                let mut lanes = [0f32; 4];
-                // SAFETY: `lanes` holds the 4 floats stored.
-                unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), sum) };
-                let [x, y, z, _] = lanes.map(f64::from);
-                Vector3::new(x, y, z)
+                widen(_mm_add_ps(
+                    _mm256_castps256_ps128(v),
+                    _mm256_extractf128_ps::<1>(v),
+                ))
             };
             *o = frame.centre + wide(p);
             *t = [wide(su), wide(sv)];
         }
+    }
+
+    /// Spreads (u₀, u₁, u₂, u₃) into (u₀ ×4, u₁ ×4, u₂ ×4, u₃ ×4): each control point's factor
+    /// across its lanes of a line.
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    fn spread_wide(u: &[f32; 4]) -> __m512 {
+        // SAFETY: `u` holds the 4 floats read.
+        let u = _mm512_castps128_ps512(unsafe { _mm_loadu_ps(u.as_ptr()) });
+        _mm512_permutexvar_ps(
+            _mm512_set_epi32(3, 3, 3, 3, 2, 2, 2, 2, 1, 1, 1, 1, 0, 0, 0, 0),
+            u,
+        )
+    }
+
+    /// The sum of a 512-bit register's four lane groups (x, y, z, 0).
+    #[target_feature(enable = "avx512f,avx")]
+    #[inline]
+    fn quarters(v: __m512) -> __m128 {
+        let high = _mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(v)));
+        let half = _mm256_add_ps(_mm512_castps512_ps256(v), high);
+        _mm_add_ps(
+            _mm256_castps256_ps128(half),
+            _mm256_extractf128_ps::<1>(half),
+        )
+    }
+
+    /// (x, y, z, 0) as an f64 vector.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn widen(v: __m128) -> Vector3 {
+        let mut lanes = [0f32; 4];
+        // SAFETY: `lanes` holds the 4 floats stored.
+        unsafe { _mm_storeu_ps(lanes.as_mut_ptr(), v) };
+        let [x, y, z, _] = lanes.map(f64::from);
+        Vector3::new(x, y, z)
     }
 
     /// Spreads (u₀, u₁, u₂, u₃) into (u₀ ×4, u₁ ×4) and (u₂ ×4, u₃ ×4): each control point's
