@@ -809,11 +809,10 @@ mod simd {
     ) {
         let lines = Lines::new(stencil, frame);
         let starts = &stencil.row_starts[first_row..=first_row + out.len()];
+        let mut blocks = cubic_blocks(stencil, starts[0]);
         for (o, span) in out.iter_mut().zip(starts.windows(2)) {
-            let blocks = span[0] as usize..span[1] as usize;
-            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
             let mut acc = _mm_setzero_ps();
-            for (f, &first) in factors.zip(&stencil.firsts[blocks]) {
+            for (f, &first) in blocks.by_ref().take((span[1] - span[0]) as usize) {
                 // Never faults, even past the end.
                 _mm_prefetch::<_MM_HINT_T0>(f.as_ptr().wrapping_add(8 * PREFETCH_BLOCKS).cast());
                 acc = _mm_add_ps(
@@ -823,6 +822,16 @@ mod simd {
             }
             *o = frame.centre + widen(acc);
         }
+    }
+
+    /// A cubic stencil's blocks from block `from` on: their factors and first control points. The
+    /// kernels take each row's count from it in turn, which spares them slicing (and its bounds
+    /// checks) per row: about an eighth of the AVX-512 kernel's time.
+    fn cubic_blocks(stencil: &TensorStencil, from: u32) -> impl Iterator<Item = (&[f32], &u32)> {
+        let from = from as usize;
+        stencil.factors[8 * from..]
+            .chunks_exact(8)
+            .zip(&stencil.firsts[from..])
     }
 
     /// The control points as the cubic kernels read them: a block's 4 lines of 4 points each.
@@ -981,11 +990,10 @@ mod simd {
     ) {
         let lines = Lines::new(stencil, frame);
         let starts = &stencil.row_starts[first_row..=first_row + out.len()];
+        let mut blocks = cubic_blocks(stencil, starts[0]);
         for (o, span) in out.iter_mut().zip(starts.windows(2)) {
-            let blocks = span[0] as usize..span[1] as usize;
-            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
             let mut acc = _mm512_setzero_ps();
-            for (f, &first) in factors.zip(&stencil.firsts[blocks]) {
+            for (f, &first) in blocks.by_ref().take((span[1] - span[0]) as usize) {
                 // Never faults, even past the end.
                 _mm_prefetch::<_MM_HINT_T0>(f.as_ptr().wrapping_add(8 * PREFETCH_BLOCKS).cast());
                 acc = lines.wide_block(f.try_into().expect("cubic factors"), first as usize, acc);
@@ -1005,14 +1013,13 @@ mod simd {
     ) {
         let lines = Lines::new(stencil, frame);
         let starts = &stencil.row_starts[first_row..=first_row + positions.len()];
+        let from = starts[0] as usize;
+        let mut blocks = cubic_blocks(stencil, starts[0])
+            .zip(stencil.tangent_factors[12 * from..].chunks_exact(12));
         for ((o, t), span) in positions.iter_mut().zip(tangents).zip(starts.windows(2)) {
-            let blocks = span[0] as usize..span[1] as usize;
-            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
-            let derivatives =
-                stencil.tangent_factors[12 * blocks.start..12 * blocks.end].chunks_exact(12);
             let zero = _mm512_setzero_ps();
             let (mut p, mut su, mut sv) = (zero, zero, zero);
-            for ((f, d), &first) in factors.zip(derivatives).zip(&stencil.firsts[blocks]) {
+            for ((f, &first), d) in blocks.by_ref().take((span[1] - span[0]) as usize) {
                 let d: &[f32; 12] = d.try_into().expect("cubic tangent factors");
                 let [a, b, c] =
                     lines.wide_jet_block(f.try_into().expect("cubic factors"), d, first as usize);
@@ -1045,17 +1052,16 @@ mod simd {
     ) {
         let lines = Lines::new(stencil, frame);
         let starts = &stencil.row_starts[first_row..=first_row + positions.len()];
+        let from = starts[0] as usize;
+        let mut blocks = cubic_blocks(stencil, starts[0])
+            .zip(stencil.tangent_factors[12 * from..].chunks_exact(12));
         for ((o, t), span) in positions.iter_mut().zip(tangents).zip(starts.windows(2)) {
-            let blocks = span[0] as usize..span[1] as usize;
-            let factors = stencil.factors[8 * blocks.start..8 * blocks.end].chunks_exact(8);
-            let derivatives =
-                stencil.tangent_factors[12 * blocks.start..12 * blocks.end].chunks_exact(12);
             let (mut p, mut su, mut sv) = (
                 _mm256_setzero_ps(),
                 _mm256_setzero_ps(),
                 _mm256_setzero_ps(),
             );
-            for ((f, d), &first) in factors.zip(derivatives).zip(&stencil.firsts[blocks]) {
+            for ((f, &first), d) in blocks.by_ref().take((span[1] - span[0]) as usize) {
                 let d: &[f32; 12] = d.try_into().expect("cubic tangent factors");
                 let [a, b, c] =
                     lines.jet_block(f.try_into().expect("cubic factors"), d, first as usize);
