@@ -351,8 +351,8 @@ pub(crate) fn set_bits(bits: &[u64]) -> Vec<u32> {
 const ROWS_PER_TASK: usize = 2048;
 
 /// About how long building a row takes on one core (ns), and locating its point: a cubic row
-/// in two or three charts (`ntori bench`'s `stencil_build_full`).
-const BUILD_NS: usize = 1200;
+/// in two or three charts (`ntori bench`'s `stencil_build_full`: 674 ns on 2026-11-30).
+const BUILD_NS: usize = 700;
 const LOCATE_NS: usize = 150;
 
 /// Fewer rows than this are not worth a task of their own.

@@ -54,10 +54,12 @@ const FOLLOW_ROWS_PER_TASK: usize = 32_768;
 
 /// About how long a row takes on one core (ns), for choosing whether to use more
 /// ([`rows_per_task`]): re-embedding a position, a position with tangents, building a row,
-/// following a row a moved window reaches (most are only bounded). From `ntori bench`.
-const POSITION_NS: usize = 15;
-const FRAME_NS: usize = 50;
-const BUILD_NS: usize = 500;
+/// following a row a moved window reaches (most are only bounded). From `ntori bench` with the
+/// AVX-512 kernels (2026-11-30: `reembed` 4.8 ns, `reembed_tangents` 8.8 ns, `stencil_build` 95 ns
+/// and `stencil_build_tangents` 147 ns a row).
+const POSITION_NS: usize = 5;
+const FRAME_NS: usize = 9;
+const BUILD_NS: usize = 150;
 const FOLLOW_NS: usize = 10;
 
 /// Which code sums a cubic stencil's rows. Each gives the same positions to rounding (tested
