@@ -179,6 +179,72 @@ impl NormalAnalysis {
         }
         Some(SparseColMat::new(self.gram.clone(), values))
     }
+
+    /// AᵀA's lower triangle on this analysis's pattern, from A and Aᵀ (both column-major), or
+    /// `None` where it has an entry outside the pattern. What [`NormalAnalysis::spread`] gives
+    /// for faer's whole AᵀA, without forming the upper triangle or a pattern again, and on all
+    /// cores: column c sums a_kc · row k of A over the rows k that reach c (Gustavson's
+    /// order), into a dense accumulator per task.
+    pub(crate) fn lower_gram(
+        &self,
+        at: &SparseColMat<usize, f64>,
+        a: &SparseColMat<usize, f64>,
+    ) -> Option<SparseColMat<usize, f64>> {
+        use rayon::prelude::*;
+        let pattern = self.gram.as_ref();
+        let cols = pattern.ncols();
+        if a.ncols() != cols || at.nrows() != cols || at.ncols() != a.nrows() {
+            return None;
+        }
+        let col_ptr = pattern.col_ptr();
+        let mut values = vec![0.0; pattern.row_idx().len()];
+        // Column ranges of about equal pattern entries, a few per core, each writing its own
+        // slice of the values.
+        let tasks = 4 * rayon::current_num_threads().max(1);
+        let per_task = values.len().div_ceil(tasks).max(1);
+        let mut bounds = vec![0];
+        for c in 1..cols {
+            if col_ptr[c] >= per_task * bounds.len() {
+                bounds.push(c);
+            }
+        }
+        bounds.push(cols);
+        let mut slices = Vec::with_capacity(bounds.len() - 1);
+        let mut rest = values.as_mut_slice();
+        for w in bounds.windows(2) {
+            let (head, tail) = rest.split_at_mut(col_ptr[w[1]] - col_ptr[w[0]]);
+            slices.push((w[0]..w[1], head));
+            rest = tail;
+        }
+        let fits = slices.into_par_iter().all(|(range, slots)| {
+            // Per task: the sums so far, and which column each unknown's pattern slot is
+            // marked for (an unknown not marked for c is outside the pattern there).
+            let mut sum = vec![0.0; cols];
+            let mut marked = vec![usize::MAX; cols];
+            let offset = col_ptr[range.start];
+            for c in range {
+                let rows = pattern.row_idx_of_col_raw(c);
+                rows.iter().for_each(|&r| marked[r] = c);
+                for (&k, &akc) in a.as_ref().row_idx_of_col_raw(c).iter().zip(a.val_of_col(c)) {
+                    let row = at.as_ref().row_idx_of_col_raw(k);
+                    // Row k's unknowns are sorted: those from c on are the lower triangle's.
+                    let from = row.partition_point(|&r| r < c);
+                    for (&r, &akr) in row[from..].iter().zip(&at.val_of_col(k)[from..]) {
+                        if marked[r] != c {
+                            return false;
+                        }
+                        sum[r] += akc * akr;
+                    }
+                }
+                let range = col_ptr[c] - offset..col_ptr[c + 1] - offset;
+                for (slot, &r) in slots[range].iter_mut().zip(rows) {
+                    *slot = std::mem::take(&mut sum[r]);
+                }
+            }
+            true
+        });
+        fits.then(|| SparseColMat::new(self.gram.clone(), values))
+    }
 }
 
 /// The lower triangle (diagonal included) of the sorted pattern `m`.
@@ -237,8 +303,16 @@ pub(crate) enum Analysis<'a> {
 pub(crate) struct Formed {
     a: SparseColMat<usize, f64>,
     at: SparseColMat<usize, f64>,
-    pub(crate) gram: SparseColMat<usize, f64>,
+    pub(crate) gram: Gram,
     seconds: [f64; 3],
+}
+
+/// AᵀA as formed.
+pub(crate) enum Gram {
+    /// Both triangles, on its own pattern.
+    Whole(SparseColMat<usize, f64>),
+    /// The lower triangle on an analysis's pattern ([`NormalAnalysis::lower_gram`]).
+    OnPattern(SparseColMat<usize, f64>),
 }
 
 /// A (`rows` × `cols`, from `triplets`), Aᵀ and AᵀA.
@@ -247,6 +321,62 @@ pub(crate) fn form(
     cols: usize,
     triplets: &[Triplet<usize, usize, f64>],
 ) -> Result<Formed, EmbeddingError> {
+    let start = std::time::Instant::now();
+    let (at, a, [built, transposed]) = transposes(rows, cols, triplets)?;
+    let gram = whole_gram(&at, &a)?;
+    Ok(Formed {
+        a,
+        at,
+        gram: Gram::Whole(gram),
+        seconds: [
+            built,
+            transposed,
+            start.elapsed().as_secs_f64() - built - transposed,
+        ],
+    })
+}
+
+/// [`form`] with AᵀA's lower triangle formed on `made`'s pattern (only the whole of it where the
+/// system reaches outside that).
+fn form_within(
+    rows: usize,
+    cols: usize,
+    triplets: &[Triplet<usize, usize, f64>],
+    made: &NormalAnalysis,
+) -> Result<Formed, EmbeddingError> {
+    let start = std::time::Instant::now();
+    let (at, a, [built, transposed]) = transposes(rows, cols, triplets)?;
+    let gram = match made.lower_gram(&at, &a) {
+        Some(lower) => Gram::OnPattern(lower),
+        None => Gram::Whole(whole_gram(&at, &a)?),
+    };
+    Ok(Formed {
+        a,
+        at,
+        gram,
+        seconds: [
+            built,
+            transposed,
+            start.elapsed().as_secs_f64() - built - transposed,
+        ],
+    })
+}
+
+/// AᵀA, both triangles, by faer.
+fn whole_gram(
+    at: &SparseColMat<usize, f64>,
+    a: &SparseColMat<usize, f64>,
+) -> Result<SparseColMat<usize, f64>, EmbeddingError> {
+    faer::sparse::linalg::matmul::sparse_sparse_matmul(at.as_ref(), a.as_ref(), 1.0, faer::Par::Seq)
+        .map_err(|e| failed(a.nrows(), a.ncols(), e))
+}
+
+/// Aᵀ and A (`rows` × `cols`, from `triplets`), both column-major, and the seconds each took.
+fn transposes(
+    rows: usize,
+    cols: usize,
+    triplets: &[Triplet<usize, usize, f64>],
+) -> Result<(SparseColMat<usize, f64>, SparseColMat<usize, f64>, [f64; 2]), EmbeddingError> {
     let start = std::time::Instant::now();
     // Aᵀ straight from the rows where they come in order (as the fit writes them): no sort of
     // the triplets, which took a third of forming AᵀA.
@@ -265,21 +395,7 @@ pub(crate) fn form(
         .transpose()
         .to_col_major()
         .map_err(|e| failed(rows, cols, e))?;
-    let transposed = start.elapsed().as_secs_f64();
-    let gram = faer::sparse::linalg::matmul::sparse_sparse_matmul(
-        at.as_ref(),
-        a.as_ref(),
-        1.0,
-        faer::Par::Seq,
-    )
-    .map_err(|e| failed(rows, cols, e))?;
-    let formed = start.elapsed().as_secs_f64();
-    Ok(Formed {
-        a,
-        at,
-        gram,
-        seconds: [built, transposed - built, formed - transposed],
-    })
+    Ok((at, a, [built, start.elapsed().as_secs_f64() - built]))
 }
 
 impl LeastSquares {
@@ -301,7 +417,8 @@ impl LeastSquares {
                 let (formed, made) = rayon::join(|| form(rows, cols, triplets), make);
                 (formed?, made.ok())
             }
-            _ => (form(rows, cols, triplets)?, None),
+            Analysis::Ahead(made) => (form_within(rows, cols, triplets, made)?, None),
+            Analysis::Here => (form(rows, cols, triplets)?, None),
         };
         let start = std::time::Instant::now();
         let analysis = match analysis {
@@ -315,27 +432,35 @@ impl LeastSquares {
             gram,
             seconds: [transpose_seconds, a_seconds, gram_seconds],
         } = formed;
-        let ahead = analysis.and_then(|made| Some((made, made.spread(&gram)?)));
-        if analysis.is_some() && ahead.is_none() {
+        // AᵀA's lower triangle on the analysis's pattern where the system stays within it (the
+        // whole AᵀA goes as soon as it is spread: the factorization reads no more), else the
+        // whole AᵀA, to be analysed anew.
+        let placed = match (gram, analysis) {
+            (Gram::OnPattern(lower), Some(made)) => Ok((made, lower)),
+            (Gram::Whole(whole), Some(made)) => made.spread(&whole).map(|l| (made, l)).ok_or(whole),
+            (Gram::Whole(whole), None) => Err(whole),
+            (Gram::OnPattern(_), None) => {
+                unreachable!("a gram on a pattern comes with its analysis")
+            }
+        };
+        if analysis.is_some() && placed.is_err() {
             tracing::debug!("the system reaches outside the analysis made ahead: analysed anew");
         }
-        let analysed_ahead = ahead.is_some();
-        let (factor, ridge) = match ahead {
-            Some((made, mut spread)) => {
-                // Its lower triangle is all the factorization reads: AᵀA itself can go first.
-                drop(gram);
+        let analysed_ahead = placed.is_ok();
+        let (factor, ridge) = match placed {
+            Ok((made, mut lower)) => {
                 let llt = |m: &SparseColMat<usize, f64>| {
                     Llt::try_new_with_symbolic(made.cholesky.clone(), m.as_ref(), faer::Side::Lower)
                 };
-                match llt(&spread) {
+                match llt(&lower) {
                     Ok(factor) => (factor, 0.0),
                     Err(_) => {
-                        add_to_diagonal(&mut spread, RIDGE);
-                        (llt(&spread).map_err(|e| failed(rows, cols, e))?, RIDGE)
+                        add_to_diagonal(&mut lower, RIDGE);
+                        (llt(&lower).map_err(|e| failed(rows, cols, e))?, RIDGE)
                     }
                 }
             }
-            None => factor_anew(&gram, rows, cols)?,
+            Err(whole) => factor_anew(&whole, rows, cols)?,
         };
         tracing::debug!(
             rows,
@@ -519,12 +644,22 @@ mod tests {
                 assert!(ahead.row(7).norm_max() < 1e-12, "seed {seed}");
             }
             let formed = form(rows, cols, &triplets).unwrap();
-            assert!(analysis.spread(&formed.gram).is_some(), "seed {seed}");
+            let Gram::Whole(whole) = &formed.gram else {
+                unreachable!("form makes the whole AᵀA")
+            };
+            let spread = analysis.spread(whole).expect("within the pattern");
+            // Formed on the pattern directly: the same lower triangle, to rounding.
+            let (at, a, _) = transposes(rows, cols, &triplets).unwrap();
+            let lower = analysis.lower_gram(&at, &a).expect("within the pattern");
+            assert_eq!(lower.row_idx(), spread.row_idx(), "seed {seed}");
+            let apart = (lower.to_dense() - spread.to_dense()).norm_max();
+            assert!(apart < 1e-13, "seed {seed}: {apart:e}");
 
             // Only the extra rows: the system's own reach outside them.
             let narrow = NormalAnalysis::new(40, cols, extra.iter().map(|t| (t.row, t.col)));
             let narrow = narrow.unwrap();
-            assert!(narrow.spread(&formed.gram).is_none(), "seed {seed}");
+            assert!(narrow.spread(whole).is_none(), "seed {seed}");
+            assert!(narrow.lower_gram(&at, &a).is_none(), "seed {seed}");
             let anew = LeastSquares::new(rows, cols, &triplets, Analysis::Ahead(&narrow))
                 .unwrap()
                 .solve(&rhs);
