@@ -14,6 +14,9 @@ const EPSILON: f64 = 1e-6;
 /// ε², what a singular AᵀA gets on its diagonal (both where it is analysed here and ahead).
 const RIDGE: f64 = EPSILON * EPSILON;
 
+/// A sparse matrix as the solver holds them (column-major).
+type Sparse = SparseColMat<usize, f64>;
+
 /// A least-squares system A x ≈ rhs, its normal equations factored.
 pub(crate) struct LeastSquares {
     a: SparseColMat<usize, f64>,
@@ -203,8 +206,8 @@ impl NormalAnalysis {
         let tasks = 4 * rayon::current_num_threads().max(1);
         let per_task = values.len().div_ceil(tasks).max(1);
         let mut bounds = vec![0];
-        for c in 1..cols {
-            if col_ptr[c] >= per_task * bounds.len() {
+        for (c, &start) in col_ptr.iter().enumerate().take(cols).skip(1) {
+            if start >= per_task * bounds.len() {
                 bounds.push(c);
             }
         }
@@ -376,7 +379,7 @@ fn transposes(
     rows: usize,
     cols: usize,
     triplets: &[Triplet<usize, usize, f64>],
-) -> Result<(SparseColMat<usize, f64>, SparseColMat<usize, f64>, [f64; 2]), EmbeddingError> {
+) -> Result<(Sparse, Sparse, [f64; 2]), EmbeddingError> {
     let start = std::time::Instant::now();
     // Aᵀ straight from the rows where they come in order (as the fit writes them): no sort of
     // the triplets, which took a third of forming AᵀA.
