@@ -219,33 +219,37 @@ impl NormalAnalysis {
             slices.push((w[0]..w[1], head));
             rest = tail;
         }
-        let fits = slices.into_par_iter().all(|(range, slots)| {
-            // Per task: the sums so far, and which column each unknown's pattern slot is
-            // marked for (an unknown not marked for c is outside the pattern there).
-            let mut sum = vec![0.0; cols];
-            let mut marked = vec![usize::MAX; cols];
-            let offset = col_ptr[range.start];
-            for c in range {
-                let rows = pattern.row_idx_of_col_raw(c);
-                rows.iter().for_each(|&r| marked[r] = c);
-                for (&k, &akc) in a.as_ref().row_idx_of_col_raw(c).iter().zip(a.val_of_col(c)) {
-                    let row = at.as_ref().row_idx_of_col_raw(k);
-                    // Row k's unknowns are sorted: those from c on are the lower triangle's.
-                    let from = row.partition_point(|&r| r < c);
-                    for (&r, &akr) in row[from..].iter().zip(&at.val_of_col(k)[from..]) {
-                        if marked[r] != c {
-                            return false;
+        // Per worker thread: the sums so far, and which column each unknown's pattern slot is
+        // marked for (an unknown not marked for c is outside the pattern there; a column's marks
+        // and sums need no clearing for the next, which the taking of the sums leaves at zero).
+        let scratch = || (vec![0.0; cols], vec![usize::MAX; cols]);
+        let fits = slices
+            .into_par_iter()
+            .try_for_each_init(scratch, |(sum, marked), (range, slots)| {
+                let offset = col_ptr[range.start];
+                for c in range {
+                    let rows = pattern.row_idx_of_col_raw(c);
+                    rows.iter().for_each(|&r| marked[r] = c);
+                    let reach = a.as_ref().row_idx_of_col_raw(c).iter().zip(a.val_of_col(c));
+                    for (&k, &akc) in reach {
+                        let row = at.as_ref().row_idx_of_col_raw(k);
+                        // Row k's unknowns are sorted: those from c on are the lower triangle's.
+                        let from = row.partition_point(|&r| r < c);
+                        for (&r, &akr) in row[from..].iter().zip(&at.val_of_col(k)[from..]) {
+                            if marked[r] != c {
+                                return Err(());
+                            }
+                            sum[r] += akc * akr;
                         }
-                        sum[r] += akc * akr;
+                    }
+                    let range = col_ptr[c] - offset..col_ptr[c + 1] - offset;
+                    for (slot, &r) in slots[range].iter_mut().zip(rows) {
+                        *slot = std::mem::take(&mut sum[r]);
                     }
                 }
-                let range = col_ptr[c] - offset..col_ptr[c + 1] - offset;
-                for (slot, &r) in slots[range].iter_mut().zip(rows) {
-                    *slot = std::mem::take(&mut sum[r]);
-                }
-            }
-            true
-        });
+                Ok(())
+            })
+            .is_ok();
         fits.then(|| SparseColMat::new(self.gram.clone(), values))
     }
 }
@@ -316,6 +320,8 @@ pub(crate) enum Gram {
     Whole(SparseColMat<usize, f64>),
     /// The lower triangle on an analysis's pattern ([`NormalAnalysis::lower_gram`]).
     OnPattern(SparseColMat<usize, f64>),
+    /// Both triangles, of a system found to reach outside the analysis's pattern.
+    Outside(SparseColMat<usize, f64>),
 }
 
 /// A (`rows` × `cols`, from `triplets`), Aᵀ and AᵀA.
@@ -351,7 +357,7 @@ fn form_within(
     let (at, a, [built, transposed]) = transposes(rows, cols, triplets)?;
     let gram = match made.lower_gram(&at, &a) {
         Some(lower) => Gram::OnPattern(lower),
-        None => Gram::Whole(whole_gram(&at, &a)?),
+        None => Gram::Outside(whole_gram(&at, &a)?),
     };
     Ok(Formed {
         a,
@@ -441,7 +447,7 @@ impl LeastSquares {
         let placed = match (gram, analysis) {
             (Gram::OnPattern(lower), Some(made)) => Ok((made, lower)),
             (Gram::Whole(whole), Some(made)) => made.spread(&whole).map(|l| (made, l)).ok_or(whole),
-            (Gram::Whole(whole), None) => Err(whole),
+            (Gram::Whole(whole), None) | (Gram::Outside(whole), _) => Err(whole),
             (Gram::OnPattern(_), None) => {
                 unreachable!("a gram on a pattern comes with its analysis")
             }

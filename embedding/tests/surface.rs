@@ -969,15 +969,16 @@ proptest! {
 }
 
 /// Over many parallel tasks, all cores give the one-thread numbers: every stencil and every way
-/// of applying one. 4·10⁴ rows are past each size from which the work is split over the cores
-/// (small jobs run on the calling thread: the pool's round trip would cost more).
+/// of applying one. 6·10⁴ rows are past each size from which the work is split over the cores
+/// (small jobs run on the calling thread: the pool's round trip would cost more; the fastest
+/// kernel's positions, 5 ns a row, split from 5·10⁴).
 #[test]
 fn stencils_give_the_same_numbers_on_all_cores() {
     let atlas = atlas(2);
     let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
     let control = noisy_controls(&layout, 11);
-    let points = atlas.tessellate(48, 48).unwrap().vertices;
-    assert!(points.len() > 40_000);
+    let points = atlas.tessellate(56, 56).unwrap().vertices;
+    assert!(points.len() > 60_000);
     let n = points.len();
     let one_thread = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -1090,7 +1091,8 @@ fn stencils_give_the_same_numbers_on_all_cores() {
 }
 
 /// Every kernel this CPU runs (the portable one, AVX with FMA, AVX-512) gives the f64 stencil's
-/// positions to 1e-6 of the diagonal, and the same as the portable kernel to rounding.
+/// positions to 1e-6 of the diagonal, and the same as the portable kernel to rounding. A kernel
+/// the CPU lacks is not run (this machine and CI's, Zen 4, run all three).
 #[test]
 fn every_kernel_gives_the_f64_stencil_s_positions() {
     let kernels: Vec<StencilKernel> = StencilKernel::ALL

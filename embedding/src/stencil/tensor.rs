@@ -53,12 +53,9 @@ const ROWS_PER_TASK: usize = 4096;
 const FOLLOW_ROWS_PER_TASK: usize = 32_768;
 
 /// About how long a row takes on one core (ns), for choosing whether to use more
-/// ([`rows_per_task`]): re-embedding a position, a position with tangents, building a row,
-/// following a row a moved window reaches (most are only bounded). From `ntori bench` with the
-/// AVX-512 kernels (2026-11-30: `reembed` 4.8 ns, `reembed_tangents` 8.8 ns, `stencil_build` 95 ns
-/// and `stencil_build_tangents` 147 ns a row).
-const POSITION_NS: usize = 5;
-const FRAME_NS: usize = 9;
+/// ([`rows_per_task`]): building a row, following a row a moved window reaches (most are only
+/// bounded). From `ntori bench` (2026-11-30: `stencil_build` 95 ns and `stencil_build_tangents`
+/// 147 ns a row). Re-embedding's depend on the kernel: [`StencilKernel::row_ns`].
 const BUILD_NS: usize = 150;
 const FOLLOW_NS: usize = 10;
 
@@ -101,6 +98,18 @@ impl StencilKernel {
         #[cfg(not(target_arch = "x86_64"))]
         let wide = |k: StencilKernel| k == StencilKernel::Portable;
         wide(self)
+    }
+
+    /// About how long this kernel takes for a cubic row on one core (ns): a position, and a
+    /// position with tangents. For choosing whether to use more cores ([`rows_per_task`]).
+    /// Measured on 2026-11-30 (genus 2, 10⁵ to 8·10⁵ rows in a loop, Zen 4): 4.9–5.4 and 8.8–9.4
+    /// ns with AVX-512, 6.0–6.3 and 10.5–10.8 with AVX, 9.3–9.6 and 22–23 portable.
+    fn row_ns(self) -> (usize, usize) {
+        match self {
+            StencilKernel::Avx512 => (5, 9),
+            StencilKernel::Avx => (6, 11),
+            StencilKernel::Portable => (10, 23),
+        }
     }
 
     /// The fastest kernel this CPU runs (the widest registers it has).
@@ -331,7 +340,11 @@ impl TensorStencil {
     pub fn positions_parallel(&self, control: &[Point3], out: &mut [Point3]) {
         let frame = ControlFrame::new(control);
         let out = &mut out[..self.rows()];
-        match rows_per_task(out.len(), ROWS_PER_TASK, POSITION_NS) {
+        match rows_per_task(
+            out.len(),
+            ROWS_PER_TASK,
+            StencilKernel::fastest().row_ns().0,
+        ) {
             None => self.rows_into(&frame, 0, out),
             Some(per_task) => out
                 .par_chunks_mut(per_task)
@@ -391,7 +404,7 @@ impl TensorStencil {
         let frame = ControlFrame::new(control);
         let rows = self.rows();
         let (positions, tangents) = (&mut positions[..rows], &mut tangents[..rows]);
-        match rows_per_task(rows, ROWS_PER_TASK, FRAME_NS) {
+        match rows_per_task(rows, ROWS_PER_TASK, StencilKernel::fastest().row_ns().1) {
             None => self.frames_into(&frame, 0, positions, tangents),
             Some(per_task) => positions
                 .par_chunks_mut(per_task)
@@ -426,6 +439,8 @@ impl TensorStencil {
         positions: &mut [Point3],
         tangents: &mut [[Vector3; 2]],
     ) {
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = kernel;
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
         #[cfg(target_arch = "x86_64")]
         if self.order == 4 {
@@ -487,7 +502,11 @@ impl TensorStencil {
                 *o = self.row_jet_of_order(frame, r as usize);
             }
         };
-        match rows_per_task(rows.len(), ROWS_PER_TASK, FRAME_NS) {
+        match rows_per_task(
+            rows.len(),
+            ROWS_PER_TASK,
+            StencilKernel::fastest().row_ns().1,
+        ) {
             None => jets(rows, out),
             Some(per_task) => rows
                 .par_chunks(per_task)
@@ -702,6 +721,8 @@ impl TensorStencil {
         first_row: usize,
         out: &mut [Point3],
     ) {
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = kernel;
         #[cfg(target_arch = "x86_64")]
         if self.order == 4 {
             match kernel {
@@ -1325,5 +1346,46 @@ impl ControlFrame {
             })
             .collect();
         ControlFrame { centre, points }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::SplineSettings;
+
+    /// A parallel task starts at some row r > 0: every kernel this CPU runs gives rows r.. the
+    /// same bits whether they start the call or follow row r − 1 in it, positions and tangents,
+    /// and an empty range writes nothing.
+    #[test]
+    fn every_kernel_starts_at_any_row() {
+        let atlas = charts::Atlas::new(2).unwrap();
+        let layout = Layout::new(&atlas, SplineSettings::default()).unwrap();
+        let control: Vec<Point3> = (0..layout.control_count())
+            .map(|i| {
+                let i = i as f64;
+                Point3::new((i * 0.37).sin(), (i * 0.71).cos(), (i * 0.13).sin())
+            })
+            .collect();
+        let points = atlas.tessellate(6, 5).unwrap().vertices;
+        let stencil = TensorStencil::build_with_tangents(&layout, &points);
+        let frame = ControlFrame::new(&control);
+        let n = stencil.rows();
+        let kernels = StencilKernel::ALL.into_iter().filter(|k| k.available());
+        for kernel in kernels {
+            let mut whole = vec![Point3::origin(); n];
+            stencil.rows_by(kernel, &frame, 0, &mut whole);
+            let mut framed = (whole.clone(), vec![[Vector3::zeros(); 2]; n]);
+            stencil.frames_by(kernel, &frame, 0, &mut framed.0, &mut framed.1);
+            for first in [1, 2, 7, n / 3, n - 1, n] {
+                let mut part = vec![Point3::origin(); n - first];
+                stencil.rows_by(kernel, &frame, first, &mut part);
+                assert_eq!(part, whole[first..], "{kernel:?} from row {first}");
+                let mut tangents = vec![[Vector3::zeros(); 2]; n - first];
+                stencil.frames_by(kernel, &frame, first, &mut part, &mut tangents);
+                assert_eq!(part, framed.0[first..], "{kernel:?} from row {first}");
+                assert_eq!(tangents, framed.1[first..], "{kernel:?} from row {first}");
+            }
+        }
     }
 }
