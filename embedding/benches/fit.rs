@@ -9,7 +9,8 @@
 //!   The plates' wider bands (`holed::PLATE_BAND`) kept the time: on a busier day genus 2 and 10
 //!   read 1.13 s and 7.20 s against 1.07 s and 7.16 s on the narrow bands, one run each in turn
 //!   (genus 32's mesh is now 372 392 triangles, at resolution 29).
-//!   On 2026-11-30 (baseline 35–39 ms) genus 2, 5 and 10 read 0.67–0.70 s, 2.37 s and 4.70–4.75 s.
+//!   On 2026-11-30 (baseline 35–39 ms) genus 2, 5 and 10 read 0.67–0.70 s, 2.37 s and 4.70–4.75 s,
+//!   and one genus-32 fit the same way outside the bench 53.6 s, 9.0 GB at its peak.
 //! - `mesh_fit`: `ntori fit`'s pipeline (greedy loops from several base vertices, the canonical
 //!   words, the map, least squares) on a genus-4 plate mesh of about 10 000 vertices (issue 14's
 //!   target: 10 s).
