@@ -188,11 +188,7 @@ impl NormalAnalysis {
     /// for faer's whole AᵀA, without forming the upper triangle or a pattern again, and on all
     /// cores: column c sums a_kc · row k of A over the rows k that reach c (Gustavson's
     /// order), into a dense accumulator per task.
-    pub(crate) fn lower_gram(
-        &self,
-        at: &SparseColMat<usize, f64>,
-        a: &SparseColMat<usize, f64>,
-    ) -> Option<SparseColMat<usize, f64>> {
+    pub(crate) fn lower_gram(&self, at: &Sparse, a: &Sparse) -> Option<Sparse> {
         use rayon::prelude::*;
         let pattern = self.gram.as_ref();
         let cols = pattern.ncols();
@@ -317,11 +313,11 @@ pub(crate) struct Formed {
 /// AᵀA as formed.
 pub(crate) enum Gram {
     /// Both triangles, on its own pattern.
-    Whole(SparseColMat<usize, f64>),
+    Whole(Sparse),
     /// The lower triangle on an analysis's pattern ([`NormalAnalysis::lower_gram`]).
-    OnPattern(SparseColMat<usize, f64>),
+    OnPattern(Sparse),
     /// Both triangles, of a system found to reach outside the analysis's pattern.
-    Outside(SparseColMat<usize, f64>),
+    Outside(Sparse),
 }
 
 /// A (`rows` × `cols`, from `triplets`), Aᵀ and AᵀA.
@@ -330,34 +326,23 @@ pub(crate) fn form(
     cols: usize,
     triplets: &[Triplet<usize, usize, f64>],
 ) -> Result<Formed, EmbeddingError> {
-    let start = std::time::Instant::now();
-    let (at, a, [built, transposed]) = transposes(rows, cols, triplets)?;
-    let gram = whole_gram(&at, &a)?;
-    Ok(Formed {
-        a,
-        at,
-        gram: Gram::Whole(gram),
-        seconds: [
-            built,
-            transposed,
-            start.elapsed().as_secs_f64() - built - transposed,
-        ],
-    })
+    form_on(rows, cols, triplets, None)
 }
 
-/// [`form`] with AᵀA's lower triangle formed on `made`'s pattern (only the whole of it where the
-/// system reaches outside that).
-fn form_within(
+/// [`form`], with AᵀA's lower triangle formed on the pattern of `ahead` where there is one (the
+/// whole of AᵀA where the system reaches outside that pattern).
+fn form_on(
     rows: usize,
     cols: usize,
     triplets: &[Triplet<usize, usize, f64>],
-    made: &NormalAnalysis,
+    ahead: Option<&NormalAnalysis>,
 ) -> Result<Formed, EmbeddingError> {
     let start = std::time::Instant::now();
     let (at, a, [built, transposed]) = transposes(rows, cols, triplets)?;
-    let gram = match made.lower_gram(&at, &a) {
-        Some(lower) => Gram::OnPattern(lower),
-        None => Gram::Outside(whole_gram(&at, &a)?),
+    let gram = match ahead.map(|made| made.lower_gram(&at, &a)) {
+        None => Gram::Whole(whole_gram(&at, &a)?),
+        Some(Some(lower)) => Gram::OnPattern(lower),
+        Some(None) => Gram::Outside(whole_gram(&at, &a)?),
     };
     Ok(Formed {
         a,
@@ -372,10 +357,7 @@ fn form_within(
 }
 
 /// AᵀA, both triangles, by faer.
-fn whole_gram(
-    at: &SparseColMat<usize, f64>,
-    a: &SparseColMat<usize, f64>,
-) -> Result<SparseColMat<usize, f64>, EmbeddingError> {
+fn whole_gram(at: &Sparse, a: &Sparse) -> Result<Sparse, EmbeddingError> {
     faer::sparse::linalg::matmul::sparse_sparse_matmul(at.as_ref(), a.as_ref(), 1.0, faer::Par::Seq)
         .map_err(|e| failed(a.nrows(), a.ncols(), e))
 }
@@ -426,7 +408,7 @@ impl LeastSquares {
                 let (formed, made) = rayon::join(|| form(rows, cols, triplets), make);
                 (formed?, made.ok())
             }
-            Analysis::Ahead(made) => (form_within(rows, cols, triplets, made)?, None),
+            Analysis::Ahead(made) => (form_on(rows, cols, triplets, Some(made))?, None),
             Analysis::Here => (form(rows, cols, triplets)?, None),
         };
         let start = std::time::Instant::now();
