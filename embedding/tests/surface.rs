@@ -1090,9 +1090,24 @@ fn stencils_give_the_same_numbers_on_all_cores() {
     assert_eq!(one, all, "tangents, rows alone, rows followed");
 }
 
+/// The grids the kernel tests run on: the default (every chart's grid the same size, the
+/// AVX-512 kernels' one line stride) and disk charts' grids larger than the squares', by an odd
+/// number of points (their other path, a stride per block).
+fn kernel_grids() -> [SplineSettings; 2] {
+    [
+        SplineSettings::default(),
+        SplineSettings {
+            grid: 14,
+            disk_grid: Some(23),
+            ..SplineSettings::default()
+        },
+    ]
+}
+
 /// Every kernel this CPU runs (the portable one, AVX with FMA, AVX-512) gives the f64 stencil's
-/// positions to 1e-6 of the diagonal, and the same as the portable kernel to rounding. A kernel
-/// the CPU lacks is not run (this machine and CI's, Zen 4, run all three).
+/// positions to 1e-6 of the diagonal, and the same as the portable kernel to rounding, with equal
+/// and with unequal grids. A kernel the CPU lacks is not run (this machine and CI's, Zen 5, run
+/// all three).
 #[test]
 fn every_kernel_gives_the_f64_stencil_s_positions() {
     let kernels: Vec<StencilKernel> = StencilKernel::ALL
@@ -1100,9 +1115,12 @@ fn every_kernel_gives_the_f64_stencil_s_positions() {
         .filter(|k| k.available())
         .collect();
     assert_eq!(kernels.last(), Some(&StencilKernel::fastest()));
-    for genus in [0, 2, 5] {
+    for (genus, settings) in [0, 2, 5]
+        .into_iter()
+        .flat_map(|g| kernel_grids().map(|s| (g, s)))
+    {
         let atlas = atlas(genus);
-        let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
+        let layout = Layout::new(atlas, settings).unwrap();
         let control = noisy_controls(&layout, 5);
         let points = atlas.tessellate(12, 9).unwrap().vertices;
         let tensor = embedding::TensorStencil::build(&layout, &points);
@@ -1121,11 +1139,11 @@ fn every_kernel_gives_the_f64_stencil_s_positions() {
             for ((a, b), c) in out.iter().zip(&portable).zip(&exact) {
                 assert!(
                     (a - b).norm() <= 1e-6 * diagonal,
-                    "genus {genus}, {kernel:?}"
+                    "genus {genus}, {settings:?}, {kernel:?}"
                 );
                 assert!(
                     (a - c).norm() <= 1e-6 * diagonal,
-                    "genus {genus}, {kernel:?}"
+                    "genus {genus}, {settings:?}, {kernel:?}"
                 );
             }
         }
@@ -1140,12 +1158,16 @@ fn every_kernel_gives_the_f64_stencil_s_positions() {
 }
 
 /// Every kernel this CPU runs gives the portable kernel's positions and tangents to rounding (1e-6
-/// of the diagonal, 1e-6 of the largest tangent), and `positions_and_tangents` runs the fastest.
+/// of the diagonal, 1e-6 of the largest tangent), with equal and with unequal grids, and
+/// `positions_and_tangents` runs the fastest.
 #[test]
 fn every_tangent_kernel_agrees_with_the_portable_one() {
-    for genus in [0, 2, 5] {
+    for (genus, settings) in [0, 2, 5]
+        .into_iter()
+        .flat_map(|g| kernel_grids().map(|s| (g, s)))
+    {
         let atlas = atlas(genus);
-        let layout = Layout::new(atlas, SplineSettings::default()).unwrap();
+        let layout = Layout::new(atlas, settings).unwrap();
         let control = noisy_controls(&layout, 9);
         let points = atlas.tessellate(12, 9).unwrap().vertices;
         let tensor = embedding::TensorStencil::build_with_tangents(&layout, &points);
@@ -1169,13 +1191,13 @@ fn every_tangent_kernel_agrees_with_the_portable_one() {
             for r in 0..n {
                 assert!(
                     (fast.0[r] - portable.0[r]).norm() <= 1e-6 * diagonal,
-                    "genus {genus}, {kernel:?}"
+                    "genus {genus}, {settings:?}, {kernel:?}"
                 );
                 for k in 0..2 {
                     let off = (fast.1[r][k] - portable.1[r][k]).norm();
                     assert!(
                         off <= 1e-6 * largest,
-                        "genus {genus}, {kernel:?}, row {r}: {off:e}"
+                        "genus {genus}, {settings:?}, {kernel:?}, row {r}: {off:e}"
                     );
                 }
             }
