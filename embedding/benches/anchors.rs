@@ -9,7 +9,8 @@
 //!   tessellation vertices; build time per point and re-embedding vertices per second, on one
 //!   thread and on all cores; and the tensor stencil's bytes streamed without its arithmetic
 //!   (`TensorStencil::stream_rows`), the ceiling memory sets for them on one core.
-//! - A triad (a = b + s·c over 192 MiB) for the memory bandwidth of this run.
+//! - A triad (a = b + s·c over 192 MiB) for the memory bandwidth of this run, on one thread (what
+//!   the one-thread rates are set against) and on all (what the all-core rate is set against).
 //!
 //! Each figure is the best of several runs, OpenSubdiv's and ntori's measured back to back. `cargo bench
 //! --bench anchors` prints the whole table; in test mode (`cargo test --benches`) it runs 10⁴ once.
@@ -52,8 +53,13 @@ fn main() {
     } else {
         println!("OpenSubdiv is not linked (apt-get install libosd-dev): ntori's side only");
     }
-    let triad = triad_bandwidth(runs.max(3));
-    println!("triad bandwidth this run: {:.2} GB/s", triad / 1e9);
+    let triad = Triad::measure(runs.max(3));
+    println!(
+        "triad bandwidth this run: {:.2} GB/s on one thread, {:.2} GB/s on {} threads",
+        triad.one / 1e9,
+        triad.all / 1e9,
+        rayon::current_num_threads()
+    );
     let (best, median) = round_trip(if full { 101 } else { 11 });
     println!(
         "rayon's round trip from this thread (an empty task on each core): best {best:.0} µs, \
@@ -94,7 +100,7 @@ fn main() {
         });
         let rival = rival.as_mut().map(|f| f as &mut dyn FnMut());
         let ours = Ntori::measure(&layout, &control, &pts, runs, &one, rival);
-        report(&osd, &ours, triad, cores);
+        report(&osd, &ours, &triad, cores);
     }
 }
 
@@ -268,7 +274,7 @@ impl Ntori {
     }
 }
 
-fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
+fn report(osd: &Osd, ours: &Ntori, triad: &Triad, cores: usize) {
     let m = |x: f64| format!("{:.1} M/s", x / 1e6);
     let ratio = |a: f64, b: Option<f64>| b.map_or("—".into(), |b| format!("{:.2}×", a / b));
     let osd_uniform = osd.uniform.as_ref().map(Uniform::fastest);
@@ -284,7 +290,7 @@ fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
                 "    OpenSubdiv uniform, {name:<18}{:>10}  {:.0} B/vertex  {:.2} of triad",
                 m(rate),
                 u.bytes,
-                rate * u.bytes / triad
+                rate * u.bytes / triad.one
             );
         }
     }
@@ -299,7 +305,7 @@ fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
         "    ntori tensor stencil          {:>10}  {:.0} B/vertex  {:.2} of triad  {} ({:.2} blocks/vertex, error {:.1e} of the diagonal)",
         m(one),
         ours.tensor_bytes,
-        one * ours.tensor_bytes / triad,
+        one * ours.tensor_bytes / triad.one,
         ratio(one, osd_uniform),
         ours.tensor_blocks,
         ours.tensor_error
@@ -308,7 +314,7 @@ fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
         "    its bytes alone (no arithmetic){:>10}  {:.0} B/vertex  {:.2} of triad: the kernel spends {:.0}% of its time on the sums",
         m(ours.tensor_stream),
         ours.tensor_bytes,
-        ours.tensor_stream * ours.tensor_bytes / triad,
+        ours.tensor_stream * ours.tensor_bytes / triad.one,
         100.0 * (1.0 - one / ours.tensor_stream).max(0.0)
     );
     if let Some(rival) = ours.rival {
@@ -330,9 +336,10 @@ fn report(osd: &Osd, ours: &Ntori, triad: f64, cores: usize) {
         ratio(ours.full_derivatives, osd.limit_derivatives.map(|l| l.0))
     );
     println!(
-        "  re-embedding on {cores} threads: ntori tensor {} ({:.2}× its one thread)",
+        "  re-embedding on {cores} threads: ntori tensor {} ({:.2}× its one thread, {:.2} of the {cores}-thread triad)",
         m(all),
-        all / one
+        all / one,
+        all * ours.tensor_bytes / triad.all
     );
     println!("  stencil build (µs per point; ratio = OpenSubdiv's limit factory ÷ ntori)");
     if let Some(u) = &osd.uniform {
@@ -424,18 +431,41 @@ fn round_trip(runs: usize) -> (f64, f64) {
     (times[0], times[times.len() / 2])
 }
 
-/// Bytes per second of a = b + s·c over three 64 MiB arrays (24 bytes per element, as STREAM
-/// counts them), best of `runs`.
-fn triad_bandwidth(runs: usize) -> f64 {
-    let n = 8 << 20;
-    let b: Vec<f64> = (0..n).map(|i| i as f64).collect();
-    let c: Vec<f64> = (0..n).map(|i| (n - i) as f64).collect();
-    let mut a = vec![0f64; n];
-    let secs = best_of(runs, || {
-        for ((a, b), c) in a.iter_mut().zip(black_box(&b)).zip(black_box(&c)) {
-            *a = b + 3.0 * c;
+/// The memory bandwidth of this run: bytes per second of a = b + s·c over three 64 MiB arrays (24
+/// bytes per element, as STREAM counts them), best of several runs, on the calling thread and on
+/// all the pool's threads (each summing its own part of the arrays).
+struct Triad {
+    one: f64,
+    all: f64,
+}
+
+impl Triad {
+    fn measure(runs: usize) -> Triad {
+        use rayon::prelude::*;
+        let n = 8 << 20;
+        let b: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let c: Vec<f64> = (0..n).map(|i| (n - i) as f64).collect();
+        let mut a = vec![0f64; n];
+        let triad = |a: &mut [f64], b: &[f64], c: &[f64]| {
+            for ((a, b), c) in a.iter_mut().zip(b).zip(c) {
+                *a = b + 3.0 * c;
+            }
+        };
+        let one = best_of(runs, || {
+            triad(&mut a, black_box(&b), black_box(&c));
+            black_box(&mut a);
+        });
+        let part = n.div_ceil(rayon::current_num_threads());
+        let all = best_of(runs, || {
+            a.par_chunks_mut(part)
+                .zip(black_box(&b).par_chunks(part))
+                .zip(black_box(&c).par_chunks(part))
+                .for_each(|((a, b), c)| triad(a, b, c));
+            black_box(&mut a);
+        });
+        Triad {
+            one: 24.0 * n as f64 / one,
+            all: 24.0 * n as f64 / all,
         }
-        black_box(&mut a);
-    });
-    24.0 * n as f64 / secs
+    }
 }

@@ -340,23 +340,21 @@ impl TensorStencil {
     /// positions = W · control, on the calling thread.
     pub fn positions(&self, control: &[Point3], out: &mut [Point3]) {
         let frame = ControlFrame::new(control);
-        self.rows_into(&frame, 0, &mut out[..self.rows()]);
+        let kernel = frame.ready(StencilKernel::fastest(), self.rows());
+        self.rows_by(kernel, &frame, 0, &mut out[..self.rows()]);
     }
 
     /// [`TensorStencil::positions`] on all cores (the same numbers: each row is summed the same way).
     pub fn positions_parallel(&self, control: &[Point3], out: &mut [Point3]) {
         let frame = ControlFrame::new(control);
         let out = &mut out[..self.rows()];
-        match rows_per_task(
-            out.len(),
-            ROWS_PER_TASK,
-            StencilKernel::fastest().row_ns().0,
-        ) {
-            None => self.rows_into(&frame, 0, out),
+        let kernel = frame.ready(StencilKernel::fastest(), out.len());
+        match rows_per_task(out.len(), ROWS_PER_TASK, kernel.row_ns().0) {
+            None => self.rows_by(kernel, &frame, 0, out),
             Some(per_task) => out
                 .par_chunks_mut(per_task)
                 .enumerate()
-                .for_each(|(k, chunk)| self.rows_into(&frame, k * per_task, chunk)),
+                .for_each(|(k, chunk)| self.rows_by(kernel, &frame, k * per_task, chunk)),
         }
     }
 
@@ -374,7 +372,14 @@ impl TensorStencil {
     ) {
         let frame = ControlFrame::new(control);
         let rows = self.rows();
-        self.frames_into(&frame, 0, &mut positions[..rows], &mut tangents[..rows]);
+        let kernel = frame.ready(StencilKernel::fastest(), rows);
+        self.frames_by(
+            kernel,
+            &frame,
+            0,
+            &mut positions[..rows],
+            &mut tangents[..rows],
+        );
     }
 
     /// [`TensorStencil::positions_and_tangents`] by `kernel`, for tests and benches that compare
@@ -392,6 +397,7 @@ impl TensorStencil {
         assert!(kernel.available(), "{kernel:?} runs on this CPU");
         let frame = ControlFrame::new(control);
         let rows = self.rows();
+        frame.ready(kernel, rows);
         self.frames_by(
             kernel,
             &frame,
@@ -411,30 +417,15 @@ impl TensorStencil {
         let frame = ControlFrame::new(control);
         let rows = self.rows();
         let (positions, tangents) = (&mut positions[..rows], &mut tangents[..rows]);
-        match rows_per_task(rows, ROWS_PER_TASK, StencilKernel::fastest().row_ns().1) {
-            None => self.frames_into(&frame, 0, positions, tangents),
+        let kernel = frame.ready(StencilKernel::fastest(), rows);
+        match rows_per_task(rows, ROWS_PER_TASK, kernel.row_ns().1) {
+            None => self.frames_by(kernel, &frame, 0, positions, tangents),
             Some(per_task) => positions
                 .par_chunks_mut(per_task)
                 .zip(tangents.par_chunks_mut(per_task))
                 .enumerate()
-                .for_each(|(k, (p, t))| self.frames_into(&frame, k * per_task, p, t)),
+                .for_each(|(k, (p, t))| self.frames_by(kernel, &frame, k * per_task, p, t)),
         }
-    }
-
-    fn frames_into(
-        &self,
-        frame: &ControlFrame,
-        first_row: usize,
-        positions: &mut [Point3],
-        tangents: &mut [[Vector3; 2]],
-    ) {
-        self.frames_by(
-            StencilKernel::fastest(),
-            frame,
-            first_row,
-            positions,
-            tangents,
-        );
     }
 
     /// [`TensorStencil::frames_into`] by `kernel`, which this CPU must run.
@@ -448,22 +439,21 @@ impl TensorStencil {
     ) {
         #[cfg(not(target_arch = "x86_64"))]
         let _ = kernel;
+        debug_assert!(kernel.available());
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
         #[cfg(target_arch = "x86_64")]
         if self.order == 4 {
             match kernel {
                 // SAFETY: the CPU runs `kernel` (the callers' choice: `StencilKernel::fastest`, or
                 // asserted available).
-                StencilKernel::Avx512 if self.grids.disk == self.grids.square => {
-                    return unsafe {
-                        simd::cubic_jets_wide::<true>(self, frame, first_row, positions, tangents)
-                    };
-                }
-                // SAFETY: as above.
                 StencilKernel::Avx512 => {
-                    return unsafe {
-                        simd::cubic_jets_wide::<false>(self, frame, first_row, positions, tangents)
+                    let f = match (self.grids.disk == self.grids.square, frame.has_quads()) {
+                        (true, true) => simd::cubic_jets_wide::<true, true>,
+                        (true, false) => simd::cubic_jets_wide::<true, false>,
+                        (false, true) => simd::cubic_jets_wide::<false, true>,
+                        (false, false) => simd::cubic_jets_wide::<false, false>,
                     };
+                    return unsafe { f(self, frame, first_row, positions, tangents) };
                 }
                 // SAFETY: as above.
                 StencilKernel::Avx => {
@@ -510,16 +500,13 @@ impl TensorStencil {
         assert!(self.has_tangents(), "a tensor stencil built with tangents");
         let frame = ControlFrame::new(control);
         let frame = &frame;
+        let kernel = frame.ready(StencilKernel::fastest(), rows.len());
         let jets = |rows: &[u32], out: &mut [(Point3, [Vector3; 2])]| {
             for (o, &r) in out.iter_mut().zip(rows) {
-                *o = self.row_jet_of_order(frame, r as usize);
+                *o = self.row_jet_of_order(kernel, frame, r as usize);
             }
         };
-        match rows_per_task(
-            rows.len(),
-            ROWS_PER_TASK,
-            StencilKernel::fastest().row_ns().1,
-        ) {
+        match rows_per_task(rows.len(), ROWS_PER_TASK, kernel.row_ns().1) {
             None => jets(rows, out),
             Some(per_task) => rows
                 .par_chunks(per_task)
@@ -575,6 +562,9 @@ impl TensorStencil {
             .get_or_init(|| RowsByFirst::new(&self.row_starts, &self.firsts));
         let origins = super::set_bits(&windows);
         let frame = ControlFrame::new(control);
+        // How many rows it follows is known only at the end; an edit's are usually far fewer
+        // than the control points, so no aligned copy of them.
+        let kernel = StencilKernel::fastest();
         let threshold = threshold as f32;
         let order = self.order;
         // Some(the row's lag) where the row was evaluated.
@@ -591,7 +581,7 @@ impl TensorStencil {
             if *lag < threshold {
                 return None;
             }
-            let (p, t) = self.row_jet_of_order(&frame, r);
+            let (p, t) = self.row_jet_of_order(kernel, &frame, r);
             write(a, b, p, t);
             Some(std::mem::take(lag))
         };
@@ -648,24 +638,34 @@ impl TensorStencil {
     }
 
     /// [`TensorStencil::row_jet`] for this stencil's order.
-    fn row_jet_of_order(&self, frame: &ControlFrame, r: usize) -> (Point3, [Vector3; 2]) {
+    fn row_jet_of_order(
+        &self,
+        kernel: StencilKernel,
+        frame: &ControlFrame,
+        r: usize,
+    ) -> (Point3, [Vector3; 2]) {
         match self.order {
-            2 => self.row_jet::<2>(frame, r),
-            3 => self.row_jet::<3>(frame, r),
-            4 => self.row_jet::<4>(frame, r),
-            5 => self.row_jet::<5>(frame, r),
-            6 => self.row_jet::<6>(frame, r),
-            7 => self.row_jet::<7>(frame, r),
-            _ => self.row_jet::<8>(frame, r),
+            2 => self.row_jet::<2>(kernel, frame, r),
+            3 => self.row_jet::<3>(kernel, frame, r),
+            4 => self.row_jet::<4>(kernel, frame, r),
+            5 => self.row_jet::<5>(kernel, frame, r),
+            6 => self.row_jet::<6>(kernel, frame, r),
+            7 => self.row_jet::<7>(kernel, frame, r),
+            _ => self.row_jet::<8>(kernel, frame, r),
         }
     }
 
-    /// One row of [`TensorStencil::tangent_kernel`] (by the fastest cubic kernel where it runs).
-    fn row_jet<const O: usize>(&self, frame: &ControlFrame, r: usize) -> (Point3, [Vector3; 2]) {
+    /// One row of [`TensorStencil::tangent_kernel`] (by `kernel` for cubics).
+    fn row_jet<const O: usize>(
+        &self,
+        kernel: StencilKernel,
+        frame: &ControlFrame,
+        r: usize,
+    ) -> (Point3, [Vector3; 2]) {
         let mut position = [Point3::origin()];
         let mut tangents = [[Vector3::zeros(); 2]];
         if O == 4 {
-            self.frames_into(frame, r, &mut position, &mut tangents);
+            self.frames_by(kernel, frame, r, &mut position, &mut tangents);
         } else {
             self.tangent_kernel::<O>(frame, r, &mut position, &mut tangents);
         }
@@ -721,12 +721,8 @@ impl TensorStencil {
         }
     }
 
-    /// Rows `first_row..first_row + out.len()`, by the fastest kernel for this order.
-    fn rows_into(&self, frame: &ControlFrame, first_row: usize, out: &mut [Point3]) {
-        self.rows_by(StencilKernel::fastest(), frame, first_row, out);
-    }
-
-    /// [`TensorStencil::rows_into`] by `kernel`, which this CPU must run.
+    /// Rows `first_row..first_row + out.len()` by `kernel`, which this CPU must run (the portable
+    /// kernel for orders other than cubic).
     fn rows_by(
         &self,
         kernel: StencilKernel,
@@ -736,17 +732,20 @@ impl TensorStencil {
     ) {
         #[cfg(not(target_arch = "x86_64"))]
         let _ = kernel;
+        debug_assert!(kernel.available());
         #[cfg(target_arch = "x86_64")]
         if self.order == 4 {
             match kernel {
                 // SAFETY: the CPU runs `kernel` (the callers' choice: `StencilKernel::fastest`, or
                 // asserted available).
-                StencilKernel::Avx512 if self.grids.disk == self.grids.square => {
-                    return unsafe { simd::cubic_rows_wide::<true>(self, frame, first_row, out) };
-                }
-                // SAFETY: as above.
                 StencilKernel::Avx512 => {
-                    return unsafe { simd::cubic_rows_wide::<false>(self, frame, first_row, out) };
+                    let f = match (self.grids.disk == self.grids.square, frame.has_quads()) {
+                        (true, true) => simd::cubic_rows_wide::<true, true>,
+                        (true, false) => simd::cubic_rows_wide::<true, false>,
+                        (false, true) => simd::cubic_rows_wide::<false, true>,
+                        (false, false) => simd::cubic_rows_wide::<false, false>,
+                    };
+                    return unsafe { f(self, frame, first_row, out) };
                 }
                 // SAFETY: as above.
                 StencilKernel::Avx => {
@@ -765,6 +764,7 @@ impl TensorStencil {
     pub fn positions_by(&self, kernel: StencilKernel, control: &[Point3], out: &mut [Point3]) {
         assert!(kernel.available(), "{kernel:?} runs on this CPU");
         let frame = ControlFrame::new(control);
+        frame.ready(kernel, self.rows());
         self.rows_by(kernel, &frame, 0, &mut out[..self.rows()]);
     }
 
@@ -850,8 +850,7 @@ mod simd {
         out: &mut [Point3],
     ) {
         let lines = Lines::new(stencil, frame);
-        let starts = &stencil.row_starts[first_row..=first_row + out.len()];
-        let rows = RowBlocks::<false>::new(stencil, starts);
+        let rows = RowBlocks::<false>::new(stencil, first_row, out.len());
         for (o, (factors, firsts, _)) in out.iter_mut().zip(rows) {
             let mut acc = _mm_setzero_ps();
             for (f, &first) in factors.iter().zip(firsts) {
@@ -981,18 +980,18 @@ mod simd {
 
     /// [`cubic_rows`] with 512-bit registers: a block's line, its four control points, in one.
     /// The lanes of control point i hold N_i(u) Σ_j β N_j(v) c_ij and are summed over i once, at
-    /// the row's end. `UNIFORM`: the disk and square charts' grids are the same size.
+    /// the row's end. `UNIFORM`: the disk and square charts' grids are the same size. `ALIGNED`:
+    /// the lines are read from the frame's quads, which must be made.
     #[target_feature(enable = "avx512f,avx512vl,avx,fma")]
-    pub(super) fn cubic_rows_wide<const UNIFORM: bool>(
+    pub(super) fn cubic_rows_wide<const UNIFORM: bool, const ALIGNED: bool>(
         stencil: &TensorStencil,
         frame: &ControlFrame,
         first_row: usize,
         out: &mut [Point3],
     ) {
-        let lines = QuadLines::<UNIFORM>::new(stencil, frame);
-        let starts = &stencil.row_starts[first_row..=first_row + out.len()];
+        let lines = WideLines::<UNIFORM, ALIGNED>::new(stencil, frame);
         let centre = centre_of(frame);
-        let rows = RowBlocks::<false>::new(stencil, starts);
+        let rows = RowBlocks::<false>::new(stencil, first_row, out.len());
         for (o, (factors, firsts, _)) in out.iter_mut().zip(rows) {
             ahead_of_store(o, PREFETCH_ROWS);
             let mut acc = _mm512_setzero_ps();
@@ -1006,16 +1005,15 @@ mod simd {
 
     /// [`cubic_jets`] with 512-bit registers, as [`cubic_rows_wide`].
     #[target_feature(enable = "avx512f,avx512vl,avx,fma")]
-    pub(super) fn cubic_jets_wide<const UNIFORM: bool>(
+    pub(super) fn cubic_jets_wide<const UNIFORM: bool, const ALIGNED: bool>(
         stencil: &TensorStencil,
         frame: &ControlFrame,
         first_row: usize,
         positions: &mut [Point3],
         tangents: &mut [[Vector3; 2]],
     ) {
-        let lines = QuadLines::<UNIFORM>::new(stencil, frame);
-        let starts = &stencil.row_starts[first_row..=first_row + positions.len()];
-        let rows = RowBlocks::<true>::new(stencil, starts);
+        let lines = WideLines::<UNIFORM, ALIGNED>::new(stencil, frame);
+        let rows = RowBlocks::<true>::new(stencil, first_row, positions.len());
         let centre = centre_of(frame);
         let zero = _mm256_setzero_pd();
         for ((o, t), (factors, firsts, derivatives)) in positions.iter_mut().zip(tangents).zip(rows)
@@ -1061,12 +1059,17 @@ mod simd {
     type Row<'a> = (&'a [[f32; 8]], &'a [u32], &'a [[f32; 12]]);
 
     impl<'a, const TANGENTS: bool> RowBlocks<'a, TANGENTS> {
-        /// The blocks of the rows whose starts are `starts`, a window of the stencil's row starts
-        /// (the stencil must have tangents if `TANGENTS`).
-        fn new(stencil: &'a TensorStencil, starts: &'a [u32]) -> RowBlocks<'a, TANGENTS> {
+        /// The blocks of rows `first_row..first_row + rows` (the stencil must have tangents if
+        /// `TANGENTS`).
+        fn new(
+            stencil: &'a TensorStencil,
+            first_row: usize,
+            rows: usize,
+        ) -> RowBlocks<'a, TANGENTS> {
+            let starts = &stencil.row_starts[first_row..=first_row + rows];
             let (factors, _) = stencil.factors.as_chunks::<8>();
             let (derivatives, _) = stencil.tangent_factors.as_chunks::<12>();
-            let end = starts.last().map_or(0, |&e| e as usize);
+            let end = starts[rows] as usize;
             // With the starts ascending, what `next` relies on.
             assert!(end <= factors.len() && end <= stencil.firsts.len());
             assert!(!TANGENTS || end <= derivatives.len(), "tangent factors");
@@ -1087,9 +1090,9 @@ mod simd {
             let span = self.starts.next()?;
             let blocks = span[0] as usize..span[1] as usize;
             debug_assert!(blocks.start <= blocks.end);
-            // SAFETY: the stencil's row starts ascend (`TensorStencil::row_starts`), and `new`
-            // checked that the last of these is within the arrays (the tangent factors too where
-            // they are sliced).
+            // SAFETY: the spans are the stencil's own row starts, which ascend
+            // (`TensorStencil::row_starts`), and `new` checked that the last of these is within
+            // the arrays (the tangent factors too where they are sliced).
             unsafe {
                 Some((
                     self.factors.get_unchecked(blocks.clone()),
@@ -1104,28 +1107,34 @@ mod simd {
         }
     }
 
-    /// The control points as the 512-bit kernels read them: a block's line is one aligned
-    /// [`Quad`](super::Quad), and its lines are the chart's grid apart (with `UNIFORM`, every chart's).
-    struct QuadLines<const UNIFORM: bool> {
-        quads: *const __m512,
+    /// The control points as the 512-bit kernels read them: a block's line, four control points,
+    /// in one register. With `ALIGNED` a line is one aligned [`Quad`](super::Quad) of the frame's
+    /// (which must be made), else the same 16 floats read in place from its points. The lines are
+    /// the chart's grid apart (with `UNIFORM`, every chart's).
+    struct WideLines<const UNIFORM: bool, const ALIGNED: bool> {
+        floats: *const f32,
         /// Control points below this are the disk charts', whose lines are `disk` apart.
         disk_points: usize,
         disk: usize,
         square: usize,
     }
 
-    impl<const UNIFORM: bool> QuadLines<UNIFORM> {
-        fn new(stencil: &TensorStencil, frame: &ControlFrame) -> QuadLines<UNIFORM> {
+    impl<const UNIFORM: bool, const ALIGNED: bool> WideLines<UNIFORM, ALIGNED> {
+        fn new(stencil: &TensorStencil, frame: &ControlFrame) -> WideLines<UNIFORM, ALIGNED> {
             let grids = stencil.grids;
             // Every block of a built stencil lies inside the layout's grids, so with this each
-            // line's load stays inside the quads (one per control point).
-            assert!(
-                frame.points.len() >= grids.count(),
-                "a control point per grid point"
-            );
+            // line's load stays inside the quads (one per control point) or the points (a line's
+            // last point is a grid point).
+            let (floats, len) = if ALIGNED {
+                let quads = frame.quads.get().expect("the frame's quads are made");
+                (quads.as_ptr().cast(), quads.len())
+            } else {
+                (frame.points.as_ptr().cast(), frame.points.len())
+            };
+            assert!(len >= grids.count(), "a control point per grid point");
             assert!(!UNIFORM || grids.disk == grids.square, "one grid size");
-            QuadLines {
-                quads: frame.quads().as_ptr().cast(),
+            WideLines {
+                floats,
                 disk_points: grids.disks * grids.disk * grids.disk,
                 disk: grids.disk,
                 square: grids.square,
@@ -1143,9 +1152,16 @@ mod simd {
                 self.disk
             };
             std::array::from_fn(|j| {
-                // SAFETY: a block's lines start at grid points, each with its quad (asserted in
-                // `new`), 64-byte aligned (`Quad`'s alignment).
-                unsafe { _mm512_load_ps(self.quads.add(first + j * grid).cast()) }
+                let start = first + j * grid;
+                // SAFETY: a block's lines start at grid points, each with its quad, and end at
+                // grid points (asserted in `new`); a quad is 64-byte aligned (`Quad`'s alignment).
+                unsafe {
+                    if ALIGNED {
+                        _mm512_load_ps(self.floats.add(16 * start))
+                    } else {
+                        _mm512_loadu_ps(self.floats.add(4 * start))
+                    }
+                }
             })
         }
 
@@ -1215,8 +1231,7 @@ mod simd {
         tangents: &mut [[Vector3; 2]],
     ) {
         let lines = Lines::new(stencil, frame);
-        let starts = &stencil.row_starts[first_row..=first_row + positions.len()];
-        let rows = RowBlocks::<true>::new(stencil, starts);
+        let rows = RowBlocks::<true>::new(stencil, first_row, positions.len());
         for ((o, t), (factors, firsts, derivatives)) in positions.iter_mut().zip(tangents).zip(rows)
         {
             let (mut p, mut su, mut sv) = (
@@ -1463,13 +1478,16 @@ pub struct ControlFrame {
     quads: OnceLock<Vec<Quad>>,
 }
 
-/// Four consecutive control points, the first of them a block line's start, on a 64-byte boundary
-/// of their own: one aligned 512-bit load. A cubic block's line read straight from
+/// Four consecutive control points on a 64-byte boundary of their own: a cubic block's line, where
+/// the first is a line's start, in one aligned 512-bit load. A cubic block's line read straight from
 /// [`ControlFrame::points`] starts on a 16-byte boundary and so straddles two cache lines three
 /// times in four, which cost the AVX-512 kernel about a tenth of its time.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(64))]
 pub(crate) struct Quad(pub [Vec4; 4]);
+
+// The AVX-512 kernels step through quads as 512-bit registers.
+const _: () = assert!(align_of::<Quad>() == 64 && size_of::<Quad>() == 64);
 
 impl ControlFrame {
     pub fn new(control: &[Point3]) -> ControlFrame {
@@ -1495,8 +1513,8 @@ impl ControlFrame {
     }
 
     /// Per control point p, points p to p + 3 (zero past the last): four times the points' memory,
-    /// made once per frame (the first call; parallel tasks share it). At 6 144 control points it
-    /// takes a few µs, against 36 µs for re-embedding even 10⁴ rows.
+    /// made once per frame, on one thread, in time proportional to the control points (a few µs
+    /// at genus 2's 6 144; re-embedding 10⁴ rows takes 36 µs).
     pub(crate) fn quads(&self) -> &[Quad] {
         self.quads.get_or_init(|| {
             let at = |p: usize| self.points.get(p).copied().unwrap_or(Vec4::ZERO);
@@ -1505,12 +1523,79 @@ impl ControlFrame {
                 .collect()
         })
     }
+
+    /// Whether [`ControlFrame::quads`] are made.
+    fn has_quads(&self) -> bool {
+        self.quads.get().is_some()
+    }
+
+    /// Makes [`ControlFrame::quads`] for a call of `rows` rows by `kernel` where they pay: the
+    /// AVX-512 kernels read their lines from the quads where these are made, else from the
+    /// points in place, with the same numbers. The copy costs about what re-embedding as many
+    /// rows as control points does, so only calls with at least that many rows make it (not an
+    /// edit's few rows, for each dab); it is made here, before the rows are split over cores.
+    /// Returns `kernel`.
+    fn ready(&self, kernel: StencilKernel, rows: usize) -> StencilKernel {
+        if kernel == StencilKernel::Avx512 && rows >= self.points.len() {
+            self.quads();
+        }
+        kernel
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::surface::SplineSettings;
+
+    /// A call of fewer rows than control points makes no aligned copy of the points, one of as
+    /// many makes it (for AVX-512 only), and the AVX-512 kernels give the same bits reading the
+    /// points in place as reading the copy, positions and tangents, equal grids or not.
+    #[test]
+    fn the_aligned_copy_is_made_for_long_calls_and_changes_no_bit() {
+        let control: Vec<Point3> = (0..100).map(|i| Point3::new(i as f64, 1.0, 2.0)).collect();
+        let frame = ControlFrame::new(&control);
+        for kernel in [StencilKernel::Portable, StencilKernel::Avx] {
+            frame.ready(kernel, 1000);
+            assert!(!frame.has_quads(), "{kernel:?} needs no copy");
+        }
+        frame.ready(StencilKernel::Avx512, 99);
+        assert!(!frame.has_quads(), "no copy for 99 rows");
+        frame.ready(StencilKernel::Avx512, 100);
+        assert!(frame.has_quads(), "the copy made for 100 rows");
+        if !StencilKernel::Avx512.available() {
+            return;
+        }
+        let atlas = charts::Atlas::new(3).unwrap();
+        let unequal = SplineSettings {
+            grid: 10,
+            disk_grid: Some(15),
+            ..SplineSettings::default()
+        };
+        for settings in [SplineSettings::default(), unequal] {
+            let layout = Layout::new(&atlas, settings).unwrap();
+            let control: Vec<Point3> = (0..layout.control_count())
+                .map(|i| {
+                    let i = i as f64;
+                    Point3::new((i * 0.37).sin(), (i * 0.71).cos(), (i * 0.13).sin())
+                })
+                .collect();
+            let points = atlas.tessellate(5, 4).unwrap().vertices;
+            let stencil = TensorStencil::build_with_tangents(&layout, &points);
+            let n = stencil.rows();
+            let run = |frame: &ControlFrame| {
+                let mut out = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
+                let mut alone = vec![Point3::origin(); n];
+                stencil.frames_by(StencilKernel::Avx512, frame, 0, &mut out.0, &mut out.1);
+                stencil.rows_by(StencilKernel::Avx512, frame, 0, &mut alone);
+                (alone, out)
+            };
+            let (in_place, copied) = (ControlFrame::new(&control), ControlFrame::new(&control));
+            copied.quads();
+            assert_eq!(run(&in_place), run(&copied), "{settings:?}");
+            assert!(!in_place.has_quads(), "read in place");
+        }
+    }
 
     /// A frame's quads are its points p to p + 3 for every p, zero past the last, each on a cache
     /// line of its own; made once.
