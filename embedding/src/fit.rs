@@ -985,8 +985,8 @@ pub fn plate_agreement(genus: u32, spline: SplineSettings) -> f64 {
 /// The resolution `ntori new` and the editor use for `genus`: [`TORUS_RESOLUTION`] for the torus,
 /// [`FINE_RESOLUTION`] for genus 3 to 16, [`DEFAULT_RESOLUTION`] for the others, or where that
 /// mesh has more triangles than the genus's budget ([`fit_triangle_budget`]; from genus 27), the
-/// finest within it: genus 27 gets 31, 28 gets 30, 29 gets 29, 31 gets 31, 32 gets 30, 48 gets
-/// 16, 64 gets 11. Where even resolution 8 has more, 8 (no genus up to 64 does: genus 64 has
+/// finest within it: genus 27 gets 30, 28 gets 29, 29 gets 28, 31 and 32 get 29, 48 gets 16, 64
+/// gets 10. Where even resolution 8 has more, 8 (no genus up to 64 does: genus 64 has
 /// 223 516 triangles at 8).
 ///
 /// Until 2026-11-29 the step down aimed 3% under the budget and left genus 27 to 29 and 31 one to

@@ -63,8 +63,8 @@ pub struct Args {
     input_mesh: Option<PathBuf>,
     /// Input mesh resolution: points around each hole (around the equator for the sphere)
     /// [default: 48 for the torus, 40 for genus 3 to 16, 32 for the others, or for high
-    /// genus nearly the finest within the default budget: 29 at genus 28, 30 at genus 32, 11 at
-    /// genus 64; the rims are sampled twice as finely across up to genus 40].
+    /// genus nearly the finest within the default budget: 29 at genus 28 and 32, 16 at genus
+    /// 48, 10 at genus 64; the rims are sampled twice as finely across up to genus 40].
     #[arg(long, value_name = "R", value_parser = clap::value_parser!(u64).range(8..=1024))]
     resolution: Option<u64>,
     /// Weight of the mesh's edge samples as fit targets besides its vertices: one point of the
