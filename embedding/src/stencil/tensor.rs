@@ -1566,22 +1566,7 @@ mod tests {
         if !StencilKernel::Avx512.available() {
             return;
         }
-        let atlas = charts::Atlas::new(3).unwrap();
-        let unequal = SplineSettings {
-            grid: 10,
-            disk_grid: Some(15),
-            ..SplineSettings::default()
-        };
-        for settings in [SplineSettings::default(), unequal] {
-            let layout = Layout::new(&atlas, settings).unwrap();
-            let control: Vec<Point3> = (0..layout.control_count())
-                .map(|i| {
-                    let i = i as f64;
-                    Point3::new((i * 0.37).sin(), (i * 0.71).cos(), (i * 0.13).sin())
-                })
-                .collect();
-            let points = atlas.tessellate(5, 4).unwrap().vertices;
-            let stencil = TensorStencil::build_with_tangents(&layout, &points);
+        for (settings, stencil, control) in stencils_on_both_grids(3, 5, 4) {
             let n = stencil.rows();
             let run = |frame: &ControlFrame| {
                 let mut out = (vec![Point3::origin(); n], vec![[Vector3::zeros(); 2]; n]);
@@ -1595,6 +1580,37 @@ mod tests {
             assert_eq!(run(&in_place), run(&copied), "{settings:?}");
             assert!(!in_place.has_quads(), "read in place");
         }
+    }
+
+    /// For the default grids and for disk grids larger than the squares' by an odd number (the
+    /// AVX-512 kernels' two stride paths): a genus-`genus` stencil with tangents on the
+    /// `te` × `tr` tessellation, and control points that vary smoothly.
+    fn stencils_on_both_grids(
+        genus: u32,
+        te: u32,
+        tr: u32,
+    ) -> Vec<(SplineSettings, TensorStencil, Vec<Point3>)> {
+        let atlas = charts::Atlas::new(genus).unwrap();
+        let points = atlas.tessellate(te, tr).unwrap().vertices;
+        let unequal = SplineSettings {
+            grid: 14,
+            disk_grid: Some(23),
+            ..SplineSettings::default()
+        };
+        [SplineSettings::default(), unequal]
+            .into_iter()
+            .map(|settings| {
+                let layout = Layout::new(&atlas, settings).unwrap();
+                let control = (0..layout.control_count())
+                    .map(|i| {
+                        let i = i as f64;
+                        Point3::new((i * 0.37).sin(), (i * 0.71).cos(), (i * 0.13).sin())
+                    })
+                    .collect();
+                let stencil = TensorStencil::build_with_tangents(&layout, &points);
+                (settings, stencil, control)
+            })
+            .collect()
     }
 
     /// A frame's quads are its points p to p + 3 for every p, zero past the last, each on a cache
@@ -1622,22 +1638,7 @@ mod tests {
     /// and an empty range writes nothing.
     #[test]
     fn every_kernel_starts_at_any_row() {
-        let atlas = charts::Atlas::new(2).unwrap();
-        let unequal = SplineSettings {
-            grid: 14,
-            disk_grid: Some(23),
-            ..SplineSettings::default()
-        };
-        for settings in [SplineSettings::default(), unequal] {
-            let layout = Layout::new(&atlas, settings).unwrap();
-            let control: Vec<Point3> = (0..layout.control_count())
-                .map(|i| {
-                    let i = i as f64;
-                    Point3::new((i * 0.37).sin(), (i * 0.71).cos(), (i * 0.13).sin())
-                })
-                .collect();
-            let points = atlas.tessellate(6, 5).unwrap().vertices;
-            let stencil = TensorStencil::build_with_tangents(&layout, &points);
+        for (settings, stencil, control) in stencils_on_both_grids(2, 6, 5) {
             let frame = ControlFrame::new(&control);
             let n = stencil.rows();
             let kernels = StencilKernel::ALL.into_iter().filter(|k| k.available());
