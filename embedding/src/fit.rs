@@ -715,7 +715,8 @@ pub fn default_plate_smoothness(genus: u32, grid: usize) -> f64 {
 /// 1e-2 (280 068 triangles), and 1e-2 gave 1.94–2.57× from 31 to 37 and 2.84× at 40, which was
 /// refused before (3.7×). Genus 48 failed at 4.05× on the narrow bands; on the wide ones
 /// (`holed::PLATE_BAND`) it passes at 2.97×, and genus 64 reads 3.23× at 2e-3, 3.17× at 1e-3 and
-/// 13× at 3e-2.
+/// 13× at 3e-2 (all against the mesh's estimate of the input's |κ|, 3.09; against the eased rims'
+/// own 4.15, which `new` takes since 2026-11-30, 2.40× at 2e-3).
 pub const PLATE_SMOOTHNESS_UP_TO: u32 = 40;
 
 /// The plates' smoothness weight on grids finer than 32 up to genus [`PLATE_SMOOTHNESS_UP_TO`]

@@ -63,6 +63,10 @@ pub struct HoledMesh {
     /// joining two points of a boundary circle, whose plan midpoint lies off the region, have
     /// none): more of the shape for the fit than the vertices give, for no more of the map.
     pub edge_samples: Vec<EdgeSample>,
+    /// The intended surface's largest principal |κ| (model units⁻¹), from its closed form
+    /// ([`Plan::max_principal_curvature`]): what the rims' profile and the circles' radii make,
+    /// whatever the mesh's sampling of them.
+    pub max_principal_curvature: f64,
 }
 
 /// A point of a [`HoledMesh`]'s intended surface between the two ends of an edge: the lift of the
@@ -184,11 +188,12 @@ pub const SPREAD_RINGS_UP_TO: u32 = 16;
 
 /// The last genus whose rims get [`RIM_REFINEMENT`] (measured up to 40; see there).
 ///
-/// Beyond, measured on 2026-11-30 with `ntori new` (largest |κ|, its ratio to the input's, and the
-/// input's, plain → rings): genus 49 9.37, 3.02× of 3.10 → 11.04, 2.76× of 4.00; 50 9.65, 3.11× →
+/// Beyond, measured on 2026-11-30 with `ntori new` (largest |κ|, its ratio to the mesh's estimate
+/// of the input's, which the check took then, and that estimate, plain → rings): genus 49 9.37, 3.02× of 3.10 → 11.04, 2.76× of 4.00; 50 9.65, 3.11× →
 /// 10.82, 2.71× of 4.00; 64 9.98, 3.23× → 12.52, 4.09× of 3.06 (the budget then leaves it a
 /// coarser mesh). So the rings raise the surface's peaks there; what they lift at 49 and 50 is
-/// the input's estimate, which the plain rims leave at 3.1 (3.9–4.1 from 33 to 40 with rings).
+/// the input's estimate, which the plain rims leave at 3.1 (3.9–4.1 from 33 to 40 with rings);
+/// `ntori new` now takes the eased rims' own peak, 4.15 ([`HoledMesh::max_principal_curvature`]).
 pub const RIM_REFINEMENT_UP_TO: u32 = 40;
 
 /// Points from `a` to `b` (both included) no more than `h` apart. The interior points are computed
@@ -314,6 +319,24 @@ impl Profile {
             Profile::Round => 0.5 * PI * t,
             Profile::Eased => 0.5 * PI * t * t * (3.0 - 2.0 * t),
             Profile::Smooth => 0.5 * PI * t * t * t * (10.0 + t * (6.0 * t - 15.0)),
+        }
+    }
+
+    /// dφ/dt.
+    fn rate(self, t: f64) -> f64 {
+        match self {
+            Profile::Round => 0.5 * PI,
+            Profile::Eased => 3.0 * PI * t * (1.0 - t),
+            Profile::Smooth => 15.0 * PI * t * t * (1.0 - t) * (1.0 - t),
+        }
+    }
+
+    /// The length ∫₀¹ cos φ that [`Profile::at`] divides by (2/π for the quarter circle, whose `at`
+    /// is that integral in closed form).
+    fn extent(self) -> f64 {
+        match self {
+            Profile::Round => 2.0 / PI,
+            Profile::Eased | Profile::Smooth => self.integral(1.0).0,
         }
     }
 
@@ -685,6 +708,41 @@ impl Plan {
         };
         let out = if nearest.hole { -1.0 } else { 1.0 };
         Some((1.0 - d / self.band, [out * ux, out * uy]))
+    }
+
+    /// The intended surface's largest principal |κ|. The flat faces have none; across a band the
+    /// lift moves each point straight away from its circle's centre, so the band is a surface of
+    /// revolution about the circle's axis, whose principal curvatures are the profile's and the
+    /// parallel's. The profile runs (W X(t), T Z(t)) / F with (X′, Z′) = (cos φ, sin φ) and F =
+    /// X(1), so its curvature is W T F φ′ / (W² cos² φ + T² sin² φ)^{3/2}; the parallel through a
+    /// point at distance ρ from the axis curves by the normal's horizontal part over ρ, with ρ =
+    /// R ± W (1 − X(t) / F) (+ round a hole, − inside the outer rim). Taken at every 1/4096 of the
+    /// band (the curvatures are smooth in t, so this is the peak to about 1e-7 of it).
+    fn max_principal_curvature(&self) -> f64 {
+        const STEPS: usize = 4096;
+        let (w, h) = (self.band, self.thickness);
+        let extent = self.profile.extent();
+        let mut peak: f64 = 0.0;
+        for circle in &self.circles {
+            let side = if circle.hole { 1.0 } else { -1.0 };
+            for i in 0..=STEPS {
+                let t = i as f64 / STEPS as f64;
+                let phi = self.profile.angle(t);
+                let (cos, sin) = (phi.cos(), phi.sin());
+                let speed = (w * cos).hypot(h * sin);
+                let profile = w * h * extent * self.profile.rate(t) / speed.powi(3);
+                let (across, _) = self.profile.at(t);
+                let rho = circle.radius + side * w * (1.0 - across);
+                // ρ = 0 only at the sphere's poles, where both curvatures are the profile's.
+                let parallel = if rho > 0.0 {
+                    h * sin / speed / rho
+                } else {
+                    0.0
+                };
+                peak = peak.max(profile.abs()).max(parallel.abs());
+            }
+        }
+        peak
     }
 
     /// The lift of a plan point to the top (or, mirrored, bottom) face: flat where it lies deeper than
@@ -1101,6 +1159,7 @@ fn lift(
         thickness: plan.thickness,
         normals,
         edge_samples,
+        max_principal_curvature: plan.max_principal_curvature(),
     })
 }
 
@@ -1187,6 +1246,48 @@ mod tests {
             let share = (sides[0] + sides[1]) / total;
             assert!((sides[0] - sides[1]).abs() < 1e-9 * total, "{sides:?}");
             assert!((0.3..0.95).contains(&share), "genus {genus}: {share}");
+        }
+    }
+
+    /// The closed form of the intended surface's peak curvature is what fine meshes of it read
+    /// with its exact normals (`quality::mesh_max_principal_curvature`, which converges to the
+    /// shape's |κ| as the mesh is refined, from below: a triangle averages the curvature over
+    /// it): the sphere and the torus exactly 1, the plates' smooth rims (genus 2 to 32) and eased
+    /// ones (from 33) within a few percent at a fine resolution, and no resolution reads more.
+    /// (Not so without the rims' rings, from genus 41: genus 64's meshes read 2.87 at resolution
+    /// 8 and 3.05 at 16 of its 4.15, the peak's triangles too few for the 99th percentile.)
+    #[test]
+    fn the_intended_peak_curvature_is_what_fine_meshes_read() {
+        for (genus, resolutions, exact) in [
+            (0, &[16, 48][..], Some(1.0)),
+            (1, &[16, 48], Some(1.0)),
+            (2, &[16, 40, 80], None),
+            (5, &[24, 48], None),
+            (33, &[12, 24], None),
+        ] {
+            let mut finest = 0.0;
+            for &resolution in resolutions {
+                let mesh = HoledMesh::new(genus, resolution).unwrap();
+                let peak = mesh.max_principal_curvature;
+                if let Some(k) = exact {
+                    assert!((peak - k).abs() < 1e-9, "genus {genus}: {peak}");
+                }
+                let read = crate::quality::mesh_max_principal_curvature(
+                    &mesh.positions,
+                    &mesh.triangles,
+                    &mesh.normals,
+                );
+                eprintln!("genus {genus} at {resolution}: closed form {peak:.4}, mesh {read:.4}");
+                assert!(
+                    read <= 1.05 * peak,
+                    "genus {genus} at {resolution}: {read} > {peak}"
+                );
+                finest = read / peak;
+            }
+            assert!(
+                finest > 0.95,
+                "genus {genus}: the finest mesh reads {finest} of it"
+            );
         }
     }
 

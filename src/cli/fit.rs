@@ -290,6 +290,7 @@ fn as_fitted<'a>(
         positions,
         triangles,
         intended_normals: None,
+        intended_max_curvature: None,
         flat_faces: None,
         rms_residual: fit.rms_residual,
         max_residual: fit.max_residual,

@@ -31,7 +31,7 @@ use super::{FitArgs, FitProgress, GenusArg};
 ///
 /// Also checks the shape, which topology cannot see: how far apart overlapping patches are where
 /// both show (a ripple's cause; at most 1% of the diagonal); the largest principal curvature |κ|
-/// against the input's own, estimated on the mesh (a crease or spike; at most 3×); the angle
+/// against the intended shape's own peak, from its closed form (a crease or spike; at most 3×); the angle
 /// between the surface's normal and the intended shape's exact normal at the input mesh's vertices
 /// (median and 90th percentile; at most 5° at the 90th); and crossing triangles of the
 /// t_e = t_r = 32 tessellation, or of 48 or 64 where 32's triangles are too coarse to tell (none).
@@ -259,10 +259,18 @@ pub struct ShapeReport {
     /// every chart's grid), so a spike between the tessellation's vertices is seen (genus 3's
     /// default plate: 5.58 at the vertices, 6.05 at the quadrature points).
     pub max_principal_curvature: f64,
-    /// The input's largest |κ|, estimated on the mesh with the reference normals
-    /// ([`embedding::quality::mesh_max_principal_curvature`]), and the surface's as a multiple of it.
+    /// The input's largest |κ|: the intended shape's own where its closed form is known (`new`'s
+    /// plates, sphere and torus: `embedding::holed::HoledMesh::max_principal_curvature`), else
+    /// estimated on the mesh with the reference normals
+    /// ([`embedding::quality::mesh_max_principal_curvature`]); and the surface's as a multiple of
+    /// it. (Until 2026-11-30 `new` took the estimate too, which reads the rims' peak only where
+    /// the mesh samples them finely: 4.7–4.8 of the smooth rims' 4.85 up to genus 32, 3.9–4.1
+    /// of the eased rims' 4.15 from 33 to 40, but 3.1–3.4 from 41, whose rims get no rings of
+    /// their own, so the check held those fits to a reference a quarter lower.)
     pub input_max_principal_curvature: f64,
     pub curvature_ratio: f64,
+    /// Where `input_max_principal_curvature` comes from.
+    pub curvature_from: NormalReference,
     /// The input mesh's sharp edges (`embedding::quality::SharpEdges`; none for `new`'s plates):
     /// the largest |κ| above leaves out the points within `CREASE_BAND` of the diagonal of them,
     /// and `crease_rounding` is the tightest radius (over the diagonal) the surface rounds them
@@ -385,14 +393,20 @@ fn measure_shape(
     stage("looking for self-intersections");
     let crossings = quality::crossings_until_clear(surface, &INTERSECTION_SAMPLES)?;
     let (first, last) = (crossings[0], crossings[crossings.len() - 1]);
-    let input_curvature =
-        quality::mesh_max_principal_curvature(fitted.positions, fitted.triangles, reference);
+    let (input_curvature, curvature_from) = match fitted.intended_max_curvature {
+        Some(k) => (k, NormalReference::Intended),
+        None => (
+            quality::mesh_max_principal_curvature(fitted.positions, fitted.triangles, reference),
+            NormalReference::Mesh,
+        ),
+    };
     Ok(ShapeReport {
         patch_disagreement: disagreement.max / diagonal,
         patch_disagreement_rms: disagreement.rms / diagonal,
         max_principal_curvature: largest,
         input_max_principal_curvature: input_curvature,
         curvature_ratio: largest / input_curvature,
+        curvature_from,
         sharp_edges: sharp.len(),
         crease_rounding: curvature.rounding(diagonal),
         normal_deviation_median: normals.median,
@@ -519,6 +533,10 @@ pub struct Fitted<'a> {
     /// The intended shape's exact normals at the mesh's vertices, where known (`new`'s plates); the
     /// normal deviation is measured against them, and otherwise against the mesh's own.
     pub intended_normals: Option<&'a [embedding::Vector3]>,
+    /// The intended shape's largest principal |κ|, where its closed form is known (`new`'s
+    /// plates); the curvature check compares against it, and otherwise against the mesh's
+    /// estimate with the reference normals.
+    pub intended_max_curvature: Option<f64>,
     /// A plate's flat faces, where known (`new`'s plates; none for the sphere and the torus),
     /// measured against `intended_normals`.
     pub flat_faces: Option<PlateFaces<'a>>,
@@ -564,6 +582,7 @@ pub fn check(
         positions,
         triangles,
         intended_normals: _,
+        intended_max_curvature: _,
         flat_faces: _,
         rms_residual,
         max_residual,
@@ -677,6 +696,7 @@ pub fn make(
         positions: &mesh.positions,
         triangles: &mesh.triangles,
         intended_normals: Some(&mesh.normals),
+        intended_max_curvature: Some(mesh.max_principal_curvature),
         flat_faces: Some(PlateFaces {
             vertices: &flat_vertices,
             half_thickness: mesh.thickness,
@@ -792,7 +812,7 @@ impl NewReport {
              (Hausdorff, t_e = t_r = {dist_t})\n\
              Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, relative error {gb:.1e} ({gbv})\n\
              patches: disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%) ({pdv})\n\
-             curvature: largest |κ| {kmax:.2}, {ratio:.2}× the input's {kin:.2}{creases} ({kv})\n\
+             curvature: largest |κ| {kmax:.2}, {ratio:.2}× the {kfrom} {kin:.2}{creases} ({kv})\n\
              normals: {nmed:.2}° from the {reference} (90%: {n90:.2}°) ({nv})\n\
              {flat}self-intersections: {crossings} crossing triangle pairs at t_e = t_r = {t} ({ev}){coarse}\n\
              area {area:.4}, {secs:.2} s\n",
@@ -827,6 +847,10 @@ impl NewReport {
             kmax = self.shape.max_principal_curvature,
             ratio = self.shape.curvature_ratio,
             kin = self.shape.input_max_principal_curvature,
+            kfrom = match self.shape.curvature_from {
+                NormalReference::Intended => "intended shape's",
+                NormalReference::Mesh => "input's",
+            },
             kv = verdict(self.shape_verdict.curvature),
             creases = self.crease_text(),
             nmed = self.shape.normal_deviation_median,

@@ -185,6 +185,8 @@ fn fit_maps_a_genus_zero_mesh_onto_the_sphere() {
     );
     let ratio = report["fit"]["shape"]["curvature_ratio"].as_f64().unwrap();
     assert!(ratio < 4.0, "{ratio}");
+    // A user's mesh has no closed form: its own estimate is the reference.
+    assert_eq!(report["fit"]["shape"]["curvature_from"], "mesh");
     assert!(report["fit"]["max_residual"].as_f64().unwrap() < 0.01);
     // The sphere's map has its distortion reported too: the dumbbell's is nearly area-preserving
     // after the stretch rounds (measured: angles 2.49 mean, areas ×1.01 mean, ×1.04 max).
