@@ -265,7 +265,7 @@ pub struct ShapeReport {
     /// ([`embedding::quality::mesh_max_principal_curvature`]); and the surface's as a multiple of
     /// it. (Until 2026-11-30 `new` took the estimate too, which reads the rims' peak only where
     /// the mesh samples them finely: 4.7–4.8 of the smooth rims' 4.85 up to genus 32, 3.9–4.1
-    /// of the eased rims' 4.15 from 33 to 40, but 3.1–3.4 from 41, whose rims get no rings of
+    /// of the eased rims' 4.15 from 33 to 40, but 2.9–3.4 from 41, whose rims get no rings of
     /// their own, so the check held those fits to a reference a quarter lower.)
     pub input_max_principal_curvature: f64,
     pub curvature_ratio: f64,
@@ -534,8 +534,8 @@ pub struct Fitted<'a> {
     /// normal deviation is measured against them, and otherwise against the mesh's own.
     pub intended_normals: Option<&'a [embedding::Vector3]>,
     /// The intended shape's largest principal |κ|, where its closed form is known (`new`'s
-    /// plates); the curvature check compares against it, and otherwise against the mesh's
-    /// estimate with the reference normals.
+    /// sphere, torus and plates); the curvature check compares against it, and otherwise against
+    /// the mesh's estimate with the reference normals.
     pub intended_max_curvature: Option<f64>,
     /// A plate's flat faces, where known (`new`'s plates; none for the sphere and the torus),
     /// measured against `intended_normals`.
