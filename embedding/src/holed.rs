@@ -64,7 +64,7 @@ pub struct HoledMesh {
     /// none): more of the shape for the fit than the vertices give, for no more of the map.
     pub edge_samples: Vec<EdgeSample>,
     /// The intended surface's largest principal |κ| (model units⁻¹), from its closed form
-    /// ([`Plan::max_principal_curvature`]): what the rims' profile and the circles' radii make,
+    /// (`Plan::max_principal_curvature`): what the rims' profile and the circles' radii make,
     /// whatever the mesh's sampling of them.
     pub max_principal_curvature: f64,
 }
