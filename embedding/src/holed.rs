@@ -215,8 +215,8 @@ pub const SPREAD_RINGS_UP_TO: u32 = 16;
 /// The last genus whose rims get [`RIM_REFINEMENT`] (measured up to 40; see there).
 ///
 /// Beyond, measured on 2026-11-30 with `ntori new` (largest |κ|, its ratio to the mesh's estimate
-/// of the input's, which the check took then, and that estimate, plain → rings): genus 49 9.37, 3.02× of 3.10 → 11.04, 2.76× of 4.00; 50 9.65, 3.11× →
-/// 10.82, 2.71× of 4.00; 64 9.98, 3.23× → 12.52, 4.09× of 3.06 (the budget then leaves it a
+/// of the input's, which the check took then, and that estimate, plain → rings): genus 49 9.37,
+/// 3.02× of 3.10 → 11.04, 2.76× of 4.00; 50 9.65, 3.11× → 10.82, 2.71× of 4.00; 64 9.98, 3.23× → 12.52, 4.09× of 3.06 (the budget then leaves it a
 /// coarser mesh). So the rings raise the surface's peaks there; what they lift at 49 and 50 is
 /// the input's estimate, which the plain rims leave at 3.1 (3.9–4.1 from 33 to 40 with rings);
 /// `ntori new` now takes the eased rims' own peak, 4.15 ([`HoledMesh::max_principal_curvature`]).
@@ -548,6 +548,15 @@ fn plate_profile(n: u32) -> Profile {
 }
 
 impl Plan {
+    /// The plan of genus `genus` at spacing `h`: the sphere, the round torus or a plate.
+    fn of_genus(genus: u32, h: f64) -> Plan {
+        match genus {
+            0 => Plan::sphere(h),
+            1 => Plan::torus(h),
+            n => Plan::plate(n, h),
+        }
+    }
+
     /// Genus 0: the round sphere of radius 1 (every plan point is in the band).
     fn sphere(h: f64) -> Plan {
         let equator = Circle {
@@ -848,12 +857,7 @@ impl HoledMesh {
             )));
         }
         let h = Plan::spacing(genus, resolution);
-        let plan = match genus {
-            0 => Plan::sphere(h),
-            1 => Plan::torus(h),
-            n => Plan::plate(n, h),
-        };
-        build(&plan, h, genus, resolution)
+        build(&Plan::of_genus(genus, h), h, genus, resolution)
     }
 }
 
@@ -1283,12 +1287,7 @@ mod tests {
     #[test]
     fn the_closed_form_peak_is_the_lifts_own() {
         for (genus, expected) in [(0, 1.0), (1, 1.0), (2, 4.8499), (5, 4.8499), (33, 4.1530)] {
-            let h = Plan::spacing(genus, 16);
-            let plan = match genus {
-                0 => Plan::sphere(h),
-                1 => Plan::torus(h),
-                n => Plan::plate(n, h),
-            };
+            let plan = Plan::of_genus(genus, Plan::spacing(genus, 16));
             let closed = plan.max_principal_curvature();
             assert!((closed - expected).abs() < 1e-4, "genus {genus}: {closed}");
             let mut reached: f64 = 0.0;
@@ -1444,10 +1443,7 @@ mod tests {
     fn the_size_bound_before_meshing_is_a_lower_bound() {
         for (genus, resolution) in [(1, 16), (2, 8), (2, 32), (3, 24), (8, 16), (16, 12)] {
             let h = Plan::spacing(genus, resolution);
-            let plan = match genus {
-                1 => Plan::torus(h),
-                n => Plan::plate(n, h),
-            };
+            let plan = Plan::of_genus(genus, h);
             let bound = triangles_at_least(&plan, 3f64.sqrt() / 4.0 * h * h);
             let count = HoledMesh::new(genus, resolution).unwrap().triangles.len();
             eprintln!("genus {genus}, resolution {resolution}: {count} triangles, bound {bound}");
