@@ -367,6 +367,8 @@ struct EveningReport {
 #[derive(Serialize)]
 struct LoopsReport {
     base_vertex: u32,
+    /// Base vertices whose markings were screened (more where the first few's maps were poor).
+    bases_screened: usize,
     /// Edges in each generator loop.
     loop_edges: Vec<usize>,
     /// Letters in each generator's canonical word (1: the loop is a canonical loop itself).
@@ -377,6 +379,7 @@ impl LoopsReport {
     fn of(fit: &MeshFit) -> LoopsReport {
         LoopsReport {
             base_vertex: fit.loops.base,
+            bases_screened: fit.loops.bases_screened,
             loop_edges: fit.loops.paths.iter().map(|p| p.len() - 1).collect(),
             canonical_word_lengths: fit.loops.canonical.iter().map(Vec::len).collect(),
         }
@@ -436,9 +439,11 @@ impl Report for FitReport<'_> {
             "loops: none (genus 0: mapped onto the sphere)".to_string()
         } else {
             format!(
-                "loops: {} through vertex {}, canonical words of up to {longest} letters",
+                "loops: {} through vertex {} (the best of {} base vertices' markings), canonical \
+                 words of up to {longest} letters",
                 self.loops.loop_edges.len(),
                 self.loops.base_vertex,
+                self.loops.bases_screened,
             )
         };
         let evening = self.evening.as_ref().map_or(String::new(), |e| {

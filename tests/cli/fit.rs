@@ -28,6 +28,8 @@ fn fit_writes_a_model_of_the_mesh_genus_that_passes_its_checks() {
     // Mostly well-shaped triangles (2.4% with an angle under 20°): mapped as they are.
     assert!(report["evening"].is_null(), "{}", report["evening"]);
     assert_eq!(report["loops"]["loop_edges"].as_array().unwrap().len(), 6);
+    // Its best marking's map scores 0.68, under `SCORE_FOR_MORE_BASES`: the first 8 bases do.
+    assert_eq!(report["loops"]["bases_screened"], 8);
     assert!(report["fit"]["max_residual"].as_f64().unwrap() < 0.01);
     // Between the vertices too (two-sided Hausdorff): measured 0.50% of the diagonal with the
     // edges' middles as data (the default), 0.89% without: most of it the coarse mesh's own facets
