@@ -1695,45 +1695,32 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    /// Vertices along a line at random positions: the bases come out in farthest-point order
-    /// (each the farthest from all before it), each once, until every vertex is one.
-    #[test]
-    fn bases_come_farthest_first_and_each_once() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut random = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for _ in 0..20 {
-            let x: Vec<f64> = (0..40).map(|_| random() * 10.0).collect();
+    proptest! {
+        /// Vertices along a line at random positions: the bases come out in farthest-point order
+        /// (each the farthest from all before it), each once, until every vertex is one or lies
+        /// where one does.
+        #[test]
+        fn bases_come_farthest_first_and_each_once(x in prop::collection::vec(0.0f64..10.0, 1..60)) {
             let mut bases = FarthestBases::new(x.len());
             let mut taken: Vec<usize> = Vec::new();
             while let Some(base) = bases.next() {
                 let base = base as usize;
-                assert!(!taken.contains(&base), "vertex {base} came twice");
-                if let Some(&first) = taken.first() {
+                prop_assert!(!taken.contains(&base), "vertex {} came twice", base);
+                if !taken.is_empty() {
                     let gap = |v: usize| {
-                        taken
-                            .iter()
-                            .map(|&b| (x[v] - x[b]).abs())
-                            .fold(f64::INFINITY, f64::min)
+                        taken.iter().map(|&b| (x[v] - x[b]).abs()).fold(f64::INFINITY, f64::min)
                     };
                     let farthest = (0..x.len()).map(gap).fold(0.0, f64::max);
-                    assert_eq!(
-                        gap(base),
-                        farthest,
-                        "after {first} and {} more",
-                        taken.len() - 1
-                    );
+                    prop_assert_eq!(gap(base), farthest);
                 }
                 taken.push(base);
                 let distance: Vec<f64> = x.iter().map(|&v| (v - x[base]).abs()).collect();
                 bases.seen_from(&distance);
             }
-            assert_eq!(taken[0], 0);
-            assert_eq!(taken.len(), x.len());
+            prop_assert_eq!(taken[0], 0);
+            // Vertices at the same place as a base are never bases themselves.
+            let places: std::collections::BTreeSet<u64> = x.iter().map(|v| v.to_bits()).collect();
+            prop_assert_eq!(taken.len(), places.len());
         }
     }
 
