@@ -300,11 +300,10 @@ fn the_quality_tessellation_is_well_shaped_and_within_tolerance_at_genus_9_and_1
 /// The all-quad tessellation over the example models of genus 0 to 10: closed, manifold, χ =
 /// 2 − 2n, every quad convex in its chart and facing outward, the chordal error of its halves
 /// within 1.1 times the tolerance, and at least 85% of quads with every corner within 45°–135°
-/// (measured: 90% at genus 10 to 98% at genus 0; the rest are the three quads of a triangle that
-/// found no partner, whose corners at the long side's midpoint open up). Genus 10's curvature
-/// spike (|κ| up to 200, where the fit's chart tangents are nearly parallel: issue 12) is the
-/// exception: there the coarser triangles the quads come from include needles of a degree or
-/// less, and up to three of the 147 000 halves turn or face away (measured: 3); more fail.
+/// (measured: 91% at genus 9 to 98% at genus 0; the rest are the three quads of a triangle that
+/// found no partner, whose corners at the long side's midpoint open up). No half turns or faces
+/// away (the genus-10 model had a curvature spike until session 57, where the coarser triangles
+/// the quads come from included needles and three halves turned).
 #[test]
 fn the_quad_tessellation_is_closed_convex_and_mostly_square() {
     use embedding::remesh::{QualitySettings, quad_mesh};
