@@ -9,8 +9,8 @@
 //! genus 2; see `SpokeGrading`), each ring fades out the rim's star points (see
 //! `smoothed_rim_radii`), and each band's quad is split along the diagonal that leaves the smaller
 //! largest angle (`band_quad`): the paper's even steps, rings copied from the rim and one
-//! diagonal everywhere make slivers at high genus. Genus 0 has no squares: two wheels (the caps) meet along the equator, divided into
-//! 4·t_e arcs.
+//! diagonal everywhere make slivers at high genus. Genus 0 has no squares: two wheels (the caps)
+//! meet along the equator, divided into 4·t_e arcs.
 //!
 //! Counts, with n the genus, e = t_e, r = t_r (tested):
 //! - genus ≥ 1: V = 2n(e² + 2e − 1) + 2 + 8n·e(r − 1), F = 4n·e² + 8n·e(2r − 1), E = 3F/2;
