@@ -7,8 +7,9 @@
 //! bend, its 99.9th percentile, the largest bend between triangles with no angle above 120°, the
 //! largest turn of the surface's own normal along an edge (which sees the surface, not the
 //! triangles' shape); the count of triangles with an angle of 170° or more; and where the largest
-//! bend lies. `NTORI_WHERE=1` adds the two triangles that bend most and, per region of the
-//! tessellation (square, inside wheel, vertex wheel), the edge along which the normal turns most.
+//! bend lies. `NTORI_WHERE=1` adds the two triangles that bend most, per region of the
+//! tessellation (square, inside wheel, vertex wheel) the edge along which the normal turns most,
+//! and where the triangles of 170° or more lie (region, and how far out in their chart).
 //! `cargo run --release -p embedding --example crease_report MODEL.json…`
 use charts::Tessellation;
 use embedding::{Point3, Stencil, Surface, Vector3};
@@ -29,6 +30,9 @@ fn main() {
         for t in [32u32, 64, 128] {
             let mesh = Placed::new(&surface, t);
             let b = mesh.bends(details);
+            if details {
+                mesh.print_flat_triangles();
+            }
             let ratio = |measure: fn(&Bends) -> f64| {
                 let value = measure(&b);
                 match &previous {
@@ -177,6 +181,36 @@ impl Placed {
             well_shaped: shapely,
             normal_turn,
             at: Point3::from((a.coords + b.coords) / 2.0),
+        }
+    }
+
+    /// Where the triangles with an angle of 170° or more lie: per region, how many at each
+    /// twentieth of the way from the wheel's centre to its farthest corner (the rim's star points;
+    /// squares by their own chart's farthest corner).
+    fn print_flat_triangles(&self) {
+        let mut reach = std::collections::HashMap::new();
+        for (k, corners) in self.tess.triangle_coords.iter().enumerate() {
+            let far = reach.entry(self.tess.triangle_charts[k]).or_insert(0.0f64);
+            *far = corners.iter().map(|z| z.norm()).fold(*far, f64::max);
+        }
+        let mut counts = std::collections::BTreeMap::new();
+        for (k, &angle) in self.largest_angles.iter().enumerate() {
+            if angle >= 170.0 {
+                let [a, b, c] = self.tess.triangle_coords[k];
+                let out = ((a + b + c) / 3.0).norm() / reach[&self.tess.triangle_charts[k]];
+                let key = (
+                    format!("{:?}", self.tess.triangle_regions[k]),
+                    (20.0 * out) as u32,
+                );
+                *counts.entry(key).or_insert(0usize) += 1;
+            }
+        }
+        for ((region, twentieth), count) in counts {
+            println!(
+                "  {count} triangles of 170° or more in the {region} at {:.2}–{:.2} of the way out",
+                f64::from(twentieth) / 20.0,
+                f64::from(twentieth + 1) / 20.0
+            );
         }
     }
 
