@@ -4,15 +4,18 @@
 //! neighbouring squares meet at the point β (and its images about the 4n corners); what the squares
 //! leave is two "wheels", one about the inside chart's centre and one about the vertex, each bounded by
 //! 4n arcs (square sides a = ±s face the inside wheel, b = ±s the vertex wheel). Then t_e divides each
-//! square into a t_e × t_e grid and each arc into t_e pieces; t_r divides each wheel's spokes, in
-//! steps that shrink toward the rim where the rim's vertices are closer than t_r's even step (from
-//! genus 2; see `SpokeGrading`), each ring fades out the rim's star points (see
+//! square into a t_e × t_e grid and each arc into t_e pieces; t_r divides each wheel's spokes (from
+//! genus 14 a whole multiple of t_r does: see [`Tessellation::wheel_rings`]), in steps that
+//! shrink toward the rim where the rim's vertices are closer than the even step (from genus 2;
+//! see `SpokeGrading`), each ring fades out the rim's star points (see
 //! `smoothed_rim_radii`), and each band's quad is split along the diagonal that leaves the smaller
 //! largest angle (`band_quad`): the paper's even steps, rings copied from the rim and one
 //! diagonal everywhere make slivers at high genus. Genus 0 has no squares: two wheels (the caps)
 //! meet along the equator, divided into 4·t_e arcs.
 //!
-//! Counts, with n the genus, e = t_e, r = t_r (tested):
+//! Counts, with n the genus, e = t_e and r the wheels' rings, t_r or a whole multiple of it from
+//! genus 14 ([`Tessellation::wheel_rings`]: the rims' 4n·t_e vertices need more rings than t_r
+//! there) (tested):
 //! - genus ≥ 1: V = 2n(e² + 2e − 1) + 2 + 8n·e(r − 1), F = 4n·e² + 8n·e(2r − 1), E = 3F/2;
 //! - genus 0:   V = 4e + 2 + 8e(r − 1),                F = 8e(2r − 1),              E = 3F/2;
 //!
@@ -45,6 +48,9 @@ pub enum Region {
 pub struct Tessellation {
     pub te: u32,
     pub tr: u32,
+    /// The steps each wheel's spokes take, the rim's included ([`Tessellation::wheel_rings`]):
+    /// t_r, or a whole multiple of it where the wheels' rims are fine for t_r.
+    pub rings: u32,
     /// Each vertex in its home chart.
     pub vertices: Vec<ChartPoint>,
     /// Vertex indices, counter-clockwise in the triangle's home chart.
@@ -68,10 +74,46 @@ pub const EDGE_INSIDE_ARC: u32 = 1;
 pub const EDGE_VERTEX_ARC: u32 = 2;
 
 impl Tessellation {
+    /// How many steps each wheel's spokes take, the rim's included: k·t_r, with k the least whole
+    /// number ≥ 1 that makes the spokes' last step, where the rim's 4n·t_e vertices lie evenly
+    /// round a circle and the last band is square (2π·k·t_r/(4n·t_e) of the even step), at least
+    /// 0.12 of the even step, and k at most 3. So k = 1 up to genus 13 at t_e = t_r, 2 at genus 14
+    /// to 26, and 3 from genus 27. At t_r = 1 the wheels stay fans (there are no bands to keep
+    /// square; the remesher's start keeps only the wheels' rims).
+    ///
+    /// Why: the rim carries 4n·t_e vertices and the spokes t_r steps, so from genus 16 the bands
+    /// near the rim were too thin for their length however the steps were graded, and the largest
+    /// bend between neighbouring triangles on `ntori new`'s plates fell by only 0.62 (genus 16),
+    /// 0.64 (24) and 0.70 (32) when t_e = t_r doubled from 32 to 64, where a smooth surface's
+    /// halves. Measured with the `crease_report` example, t = 32 → 64, on those plates:
+    ///
+    /// | genus | k | largest bend | ratio | triangles ≥ 170° at 32 | triangles at 32 |
+    /// |---|---|---|---|---|---|
+    /// | 16 | 1 → 2 | 56.4° → 35.0° ⟶ 29.2° → 16.9° | 0.62 ⟶ 0.58 | 34 ⟶ 0 | 324k ⟶ 586k |
+    /// | 24 | 1 → 2 | 76.4° → 49.2° ⟶ 34.1° → 19.5° | 0.64 ⟶ 0.57 | 535 ⟶ 140 | 485k ⟶ 879k |
+    /// | 32 | 1 → 3 | 95.6° → 66.6° ⟶ 29.7° → 16.2° | 0.70 ⟶ 0.55 | 1 369 ⟶ 97 | 647k ⟶ 1.70M |
+    ///
+    /// (genus 32 at k = 2: 39.6° → 23.8°, 0.60; genus 10 keeps k = 1: 43.5° → 25.4°, 0.58).
+    /// Doubling t_r alone at genus 16 (t_e = 32) had halved the bend, and doubling t_e alone had
+    /// raised it: the rings were what the wheels lacked. Why at most 3: the wheels' triangles grow
+    /// as k·n·t_e·t_r, so with k growing as n they would grow as n²: genus 64 at t = 32 would have
+    /// 5.5 million triangles at k = 5, past `ntori render`'s and `ntori tessellate`'s limits,
+    /// where k = 3 makes 3.4 million (k = 1: 1.3 million). The crease test asks for genus 32 at
+    /// most, which k = 3 meets.
+    pub fn wheel_rings(genus: u32, te: u32, tr: u32) -> u64 {
+        if tr <= 1 {
+            return u64::from(tr);
+        }
+        let rim = 4.0 * f64::from(genus.max(1)) * f64::from(te);
+        let k = (LEAST_NOMINAL_LAST_STEP * rim / (std::f64::consts::TAU * f64::from(tr))).ceil();
+        (k.clamp(1.0, MAX_RING_FACTOR) as u64) * u64::from(tr)
+    }
+
     /// The vertex count the module's formula predicts (t_e, t_r ≥ 1), saturating at `u64::MAX`:
     /// callers compare it with their limits before any work, whatever numbers a user typed.
     pub fn expected_vertices(genus: u32, te: u32, tr: u32) -> u64 {
-        let (n, e, r) = (u128::from(genus), u128::from(te), u128::from(tr));
+        let (n, e) = (u128::from(genus), u128::from(te));
+        let r = u128::from(Self::wheel_rings(genus, te, tr));
         let count = if genus == 0 {
             4 * e + 2 + 8 * e * r.saturating_sub(1)
         } else {
@@ -82,7 +124,8 @@ impl Tessellation {
 
     /// The triangle count the module's formula predicts (t_e, t_r ≥ 1), saturating at `u64::MAX`.
     pub fn expected_triangles(genus: u32, te: u32, tr: u32) -> u64 {
-        let (n, e, r) = (u128::from(genus), u128::from(te), u128::from(tr));
+        let (n, e) = (u128::from(genus), u128::from(te));
+        let r = u128::from(Self::wheel_rings(genus, te, tr));
         let count = if genus == 0 {
             8 * e * (2 * r).saturating_sub(1)
         } else {
@@ -155,7 +198,7 @@ impl Builder<'_> {
             .map(|&id| Ok((id, self.coords_in(id, chart, what)?)))
             .collect::<Result<_, ChartsError>>()?;
         ring.sort_by(|a, b| a.1.arg().total_cmp(&b.1.arg()));
-        let tr = self.t.tr;
+        let tr = self.t.rings;
         let spoke = SpokeGrading::for_wheel(&ring, tr);
         let smoothed = smoothed_rim_radii(&ring, self.t.te.div_ceil(4) as usize);
         let centre = self.vertex(ChartPoint::new(chart, Complex64::ZERO));
@@ -282,6 +325,15 @@ fn largest_angle(z: [Complex64; 3]) -> f64 {
 /// larger p thickens the band next to the rim where the points stand highest.
 const RIM_POINTS_KEPT_POWER: i32 = 6;
 
+/// The least last step, as a fraction of the even step, that the nominal grading of a wheel's
+/// spokes may have before the wheel gets more rings than t_r ([`Tessellation::wheel_rings`]): at
+/// t_e = t_r it is 2π/4n, 0.157 at genus 10, whose largest bend halved (0.58), and 0.098 at genus
+/// 16, whose did not (0.62).
+const LEAST_NOMINAL_LAST_STEP: f64 = 0.12;
+
+/// The most rings a wheel gets per t_r ([`Tessellation::wheel_rings`]).
+const MAX_RING_FACTOR: f64 = 3.0;
+
 /// The rim's radius at each rim vertex averaged over `half_window` rim vertices either side, or the
 /// vertex's own where that is less (so no inner ring reaches past the rim).
 ///
@@ -384,6 +436,8 @@ impl Atlas {
             t: Tessellation {
                 te,
                 tr,
+                // Within MAX_TRIANGLES, as just checked.
+                rings: Tessellation::wheel_rings(self.genus(), te, tr) as u32,
                 vertices: Vec::new(),
                 triangles: Vec::with_capacity(triangles as usize),
                 triangle_charts: Vec::new(),

@@ -12,7 +12,7 @@ use super::{spinner, write_stdout};
 ///
 /// Uses the GPU if there is one, and otherwise Mesa's software Vulkan (lavapipe; on Debian or
 /// Ubuntu: apt-get install mesa-vulkan-drivers). The surface is tessellated at t_e = t_r = T (by
-/// default 32, or 64 from genus 8 on, whose t = 32 triangles are coarse on the outer rim) and
+/// default 32, or 64 at genus 8 to 13, whose t = 32 triangles are coarse on the outer rim) and
 /// evaluated exactly at the vertices, with analytic normals. Styles:
 ///   shaded      lit surface;
 ///   wireframe   the tessellation's edges over the shading (try a small T);
@@ -50,7 +50,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = CurvatureArg::Gaussian)]
     curvature: CurvatureArg,
     /// Tessellation t_e = t_r (1 to 256) [default: 32, or 64 from genus 8 on where that makes at
-    /// most 1.5 million triangles]
+    /// most 1.5 million triangles: genus 8 to 13]
     #[arg(long, value_name = "T", value_parser = clap::value_parser!(u32).range(1..=256))]
     tessellation: Option<u32>,
     /// Print nothing on success.

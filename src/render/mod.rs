@@ -153,7 +153,7 @@ impl Default for RenderOptions {
 }
 
 /// The tessellation `ntori render` draws a model of `genus` at where none is chosen: 32, or 64
-/// from genus 8 on where that stays within [`DEFAULT_MAX_TRIANGLES`]. At high genus the
+/// from genus 8 on where that stays within [`DEFAULT_MAX_TRIANGLES`] (genus 8 to 13). At high genus the
 /// t = 32 tessellation's triangles grow large on the plates' outer rim, and their chords showed as
 /// notches in its silhouette (genus 10 and 16) where the surface is within 0.02% of the diagonal
 /// of the intended rim (the `rim_report` example); at 64 they all but go.
@@ -163,9 +163,11 @@ pub fn default_tessellation(genus: u32) -> u32 {
     if genus >= 8 && fits { FINE } else { 32 }
 }
 
-/// The most triangles [`default_tessellation`] chooses: genus 16 at t = 64 has 1.3 million
-/// (genus 8 to 18 get 64), which lavapipe draws at 1024 × 768 in a few seconds and whose vertex
-/// buffer stays well inside wgpu's default 256 MiB limit.
+/// The most triangles [`default_tessellation`] chooses at t = 64: genus 13 there has 1.1 million
+/// (genus 8 to 13 get 64; from genus 14 the wheels take twice t_r's rings, see
+/// `charts::Tessellation::wheel_rings`, and t = 32 is as fine across them), which lavapipe draws
+/// at 1024 × 768 in a few seconds and whose vertex buffer stays well inside wgpu's default
+/// 256 MiB limit.
 pub const DEFAULT_MAX_TRIANGLES: u64 = 1_500_000;
 
 /// A polyline on the surface, drawn on top of it.
