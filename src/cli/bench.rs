@@ -15,10 +15,11 @@ use super::{GenusArg, spinner, write_stdout};
 /// Measure throughput and print it as JSON.
 ///
 /// Figures for tessellation, point location, stencil building (the tensor stencil on all cores, and
-/// the full f64 stencil with derivatives), re-embedding (the tensor stencil on one thread and on all
-/// cores, and the full stencil; each also as a fraction of memory copy bandwidth) and drag events. Baselines (copy bandwidth, a chain of scalar
-/// multiply-adds) are measured in the same run, and every figure is also given per baseline
-/// operation, since this machine is shared and noisy.
+/// the full f64 stencil with derivatives), re-embedding (the tensor stencil on one thread and on
+/// all cores, and the full stencil; each also as a fraction of memory copy bandwidth) and drag
+/// events. Baselines (copy bandwidth, a chain of scalar multiply-adds) are measured in the same
+/// run, and every figure is also given per baseline operation, since this machine is shared and
+/// noisy.
 ///
 /// For statistics and history use `cargo bench`; this is the quick look.
 #[derive(clap::Args, Debug)]

@@ -37,11 +37,11 @@ use super::{FitArgs, FitProgress};
 /// comes closer to them is kept. Where the fit at the default smoothness is rough by the checks
 /// (|κ| over 4× the mesh's, patches over 1% apart, normals over 15° off at the 90th percentile, a
 /// residual over 1%: a smooth surface rings beside sharp edges), it is fitted again with λ five
-/// times larger, up to 1, and the first that passes, else the one with the fewest failing, is
-/// kept; --smoothness fixes λ. If a check
-/// fails, no model is written (unless --keep-failed) and the exit status is 3. A genus-0 mesh is
-/// mapped onto the sphere instead (no loops); where the relaxation there leaves long limbs
-/// squeezed, the map is made again in rounds of planar solves that even its area out.
+/// times larger, up to 1, and the first that passes, else the one with the fewest failing, is kept;
+/// --smoothness fixes λ. If a check fails, no model is written (unless --keep-failed) and the exit
+/// status is 3. A genus-0 mesh is mapped onto the sphere instead (no loops); where the relaxation
+/// there leaves long limbs squeezed, the map is made again in rounds of planar solves that even its
+/// area out.
 ///
 /// Examples:
 ///   ntori fit assets/meshes/plate-genus-3.obj -o plate.json
@@ -68,7 +68,7 @@ pub struct Args {
     largest: bool,
     /// Read the mesh as a Catmull–Clark subdivision cage and fit its limit surface (refined and
     /// evaluated by OpenSubdiv), not its polygons; the limit normals are the intended shape's, and
-    /// the grid is `new`'s (32) unless --grid says otherwise.
+    /// the grid is 32 unless --grid says otherwise.
     #[arg(long, conflicts_with = "largest")]
     cage: bool,
     /// Levels of uniform refinement of the cage [default: the fewest from 2 that make 12 000
@@ -108,10 +108,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = std::time::Instant::now();
     // A missing or unreadable input is the first thing to say, before anything about the output.
     import::check_input(&args.mesh)?;
-    let target = ntori::io::atomic::check_output(&args.output, &[&args.mesh])?;
-    if !args.force && std::fs::symlink_metadata(&target).is_ok() {
-        return Err(ntori::io::atomic::FileError::Exists { path: args.output }.into());
-    }
+    ntori::io::atomic::check_new_output(&args.output, &[&args.mesh], args.force)?;
     let read = import::read_mesh(&args.mesh)?;
     let (merged, triangulated) = (read.merged_vertices, read.triangulated_polygons);
     let (valid, cage) = if args.cage {
@@ -440,10 +437,11 @@ impl Report for FitReport<'_> {
         } else {
             format!(
                 "loops: {} through vertex {} (the best of {} base vertices' markings), canonical \
-                 words of up to {longest} letters",
+                 words of up to {longest} {}",
                 self.loops.loop_edges.len(),
                 self.loops.base_vertex,
                 self.loops.bases_screened,
+                if *longest == 1 { "letter" } else { "letters" },
             )
         };
         let evening = self.evening.as_ref().map_or(String::new(), |e| {

@@ -271,10 +271,11 @@ impl Report for InfoReport {
                 .collect();
             let _ = writeln!(
                 s,
-                "  {:>6} → {:<6} {:>5} pairs: {}",
+                "  {:>6} → {:<6} {:>5} {}: {}",
                 o.from,
                 o.to,
                 o.pairs,
+                if o.pairs == 1 { "pair" } else { "pairs" },
                 hist.join(", ")
             );
         }

@@ -99,7 +99,7 @@ struct FitArgs {
     /// torus and 48 from genus 2 (a coarser grid ripples there), but 40 from genus 5 to 16 (whose
     /// disk charts take the finer grids) and 64 at genus 30 to 32; for fit 40, and 80 for a genus-0 mesh (its two
     /// charts carry the whole surface); 32 for fit --cage]
-    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=MAX_GRID))]
+    #[arg(long, value_name = "G", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(4..=MAX_GRID))]
     grid: Option<u64>,
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which
     /// carry most of a high-genus surface and are coarse at their rims) [default: for new twice
@@ -107,7 +107,7 @@ struct FitArgs {
     /// from genus 11 (160 at 40), five times at 16 (200), 16/3 from genus 17 (256 at 48) and 8 times from genus 34
     /// (384), the grid below genus 3; for fit twice the grid from genus
     /// 2 (80 at 40), the grid below; the grid for fit --cage]
-    #[arg(long, value_name = "G", value_parser = clap::value_parser!(u64).range(4..=512))]
+    #[arg(long, value_name = "G", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(4..=512))]
     disk_grid: Option<u64>,
     /// Spline degree.
     #[arg(long, default_value_t = SplineSettings::default().degree as u64, value_name = "P",
@@ -123,13 +123,13 @@ struct FitArgs {
     /// smaller for the same shape, and 1e-2 for new's plates of genus 2 to 40 on those (3e-2 at genus
     /// 27 to 32); `fit` raises
     /// it where that leaves the surface rough]
-    #[arg(long, value_name = "λ", value_parser = parse_smoothness)]
+    #[arg(long, value_name = "λ", allow_negative_numbers = true, value_parser = parse_smoothness)]
     smoothness: Option<f64>,
     /// Weight of the rows that make overlapping charts' patches agree with each other between the
     /// input's points, where both blends are at least 0.05 (0: none; relative to the data term)
     /// [default: 0.3 for new's plates from genus 17, whose charts barely overlap, with disk grids
     /// at least five times the grid; 0 otherwise]
-    #[arg(long, value_name = "W", value_parser = parse_agreement)]
+    #[arg(long, value_name = "W", allow_negative_numbers = true, value_parser = parse_agreement)]
     agreement: Option<f64>,
 }
 

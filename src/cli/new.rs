@@ -31,11 +31,11 @@ use super::{FitArgs, FitProgress, GenusArg};
 ///
 /// Also checks the shape, which topology cannot see: how far apart overlapping patches are where
 /// both show (a ripple's cause; at most 1% of the diagonal); the largest principal curvature |κ|
-/// against the intended shape's own peak, from its closed form (a crease or spike; at most 3×); the angle
-/// between the surface's normal and the intended shape's exact normal at the input mesh's vertices
-/// (median and 90th percentile; at most 5° at the 90th); and crossing triangles of the
-/// t_e = t_r = 32 tessellation, or of 48 or 64 where 32's triangles are too coarse to tell (none).
-/// From genus 2 it also reports, unchecked, how flat the plate's flat faces came out: their mean
+/// against the intended shape's own peak, from its closed form (a crease or spike; at most 3×); the
+/// angle between the surface's normal and the intended shape's exact normal at the input mesh's
+/// vertices (median and 90th percentile; at most 5° at the 90th); and crossing triangles of the t_e
+/// = t_r = 32 tessellation, or of 48 or 64 where 32's triangles are too coarse to tell (none). From
+/// genus 2 it also reports, unchecked, how flat the plate's flat faces came out: their mean
 /// curvature |H| (median, 90th percentile, and that times the half-thickness) and the normals'
 /// angle from ±z.
 ///
@@ -117,17 +117,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     // Before the fit (seconds to minutes): the directory exists and takes files, the output is no
     // special file, and without --force it does not exist yet.
-    let target = ntori::io::atomic::check_output(&output, &[])?;
-    if !force && std::fs::symlink_metadata(&target).is_ok() {
-        return Err(ntori::io::atomic::FileError::Exists { path: output }.into());
-    }
+    ntori::io::atomic::check_new_output(&output, &[], force)?;
     let input_mesh = match input_mesh {
         Some(path) => {
-            let format = Format::from_path(&path)?;
-            let target = ntori::io::atomic::check_output(&path, &[&output])?;
-            if !force && std::fs::symlink_metadata(&target).is_ok() {
-                return Err(ntori::io::atomic::FileError::Exists { path }.into());
-            }
+            // `new` has no --format: the mesh's format comes from its name alone.
+            let format = Format::from_path(&path).map_err(|_| {
+                anyhow::anyhow!(
+                    "{} has no known extension (.obj, .ply, .stl, .glb, .3mf, .off): \
+                     --input-mesh takes the mesh's format from it",
+                    path.display()
+                )
+            })?;
+            ntori::io::atomic::check_new_output(&path, &[&output], force)?;
             Some((path, format))
         }
         None => None,
@@ -238,6 +239,8 @@ pub struct NewReport {
     pub expected_curvature: f64,
     /// |∫K dA − 2π(2 − 2n)| / max(|2π(2 − 2n)|, ∫|K| dA).
     pub curvature_error: f64,
+    /// ∫|K| dA, which `curvature_error` is relative to where it is the larger.
+    pub absolute_curvature: f64,
     pub area: f64,
     /// Measures of shape (see `embedding::quality`), and which of them pass.
     pub shape: ShapeReport,
@@ -644,6 +647,7 @@ pub fn check(
         total_curvature: sums.gaussian_curvature,
         expected_curvature: expected,
         curvature_error,
+        absolute_curvature: sums.absolute_curvature,
         area: sums.area,
         shape,
         shape_verdict,
@@ -799,6 +803,16 @@ impl NewReport {
         })
     }
 
+    /// What the Gauss–Bonnet error is a fraction of: ∫|K| dA or |2π(2 − 2n)|, the larger (the
+    /// torus's 2π(2 − 2n) is 0, and a bumpy sphere's ∫|K| dA is many times its 4π).
+    fn gauss_bonnet_scale(&self) -> String {
+        if self.absolute_curvature >= self.expected_curvature.abs() {
+            format!("∫|K| dA = {:.3}", self.absolute_curvature)
+        } else {
+            "|2π(2 − 2n)|".to_string()
+        }
+    }
+
     /// The human-readable form (without the line saying where the model went).
     pub fn to_text(&self) -> String {
         let verdict = |ok: bool| if ok { "ok" } else { "FAILED" };
@@ -810,7 +824,7 @@ impl NewReport {
              fit residual: rms {rms:.3}%, max {max:.3}% of the diagonal ({res})\n\
              distance: surface and input mesh within {dist:.3}% of the diagonal of each other \
              (Hausdorff, t_e = t_r = {dist_t})\n\
-             Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, relative error {gb:.1e} ({gbv})\n\
+             Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, off by {gb:.1e} of {gb_of} ({gbv})\n\
              patches: disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%) ({pdv})\n\
              curvature: largest |κ| {kmax:.2}, {ratio:.2}× the {kfrom} {kin:.2}{creases} ({kv})\n\
              normals: {nmed:.2}° from the {reference} (90%: {n90:.2}°) ({nv})\n\
@@ -840,6 +854,7 @@ impl NewReport {
             k = self.total_curvature,
             e = self.expected_curvature,
             gb = self.curvature_error,
+            gb_of = self.gauss_bonnet_scale(),
             gbv = verdict(self.curvature_error <= CURVATURE_TOLERANCE),
             pd = 100.0 * self.shape.patch_disagreement,
             pdr = 100.0 * self.shape.patch_disagreement_rms,

@@ -53,6 +53,9 @@ pub struct Args {
     /// most 1.5 million triangles: genus 8 to 13]
     #[arg(long, value_name = "T", value_parser = clap::value_parser!(u32).range(1..=256))]
     tessellation: Option<u32>,
+    /// Replace the output file if it exists.
+    #[arg(long)]
+    force: bool,
     /// Print nothing on success.
     #[arg(short, long)]
     quiet: bool,
@@ -82,6 +85,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         curvature,
         tessellation,
         quiet,
+        force,
     } = args;
     let style = match style {
         StyleArg::Shaded => Style::Shaded,
@@ -92,7 +96,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             CurvatureArg::Mean => CurvatureKind::Mean,
         }),
     };
-    ntori::io::atomic::check_output(&output, &[&model])?;
+    ntori::io::atomic::check_new_output(&output, &[&model], force)?;
     let loaded = ntori::io::model_file::load(&model)?;
     let options = RenderOptions {
         width: size.0,
@@ -110,7 +114,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .render_model_png(&loaded, &options, &[])
         .with_context(|| format!("cannot render {}", model.display()))?;
     bar.finish_and_clear();
-    ntori::io::atomic::write_atomically(&output, &png)?;
+    ntori::io::atomic::write_output(&output, &png, force)?;
     if !quiet {
         write_stdout(&format!(
             "wrote {} ({}×{}, {})\n",

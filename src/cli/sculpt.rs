@@ -11,14 +11,13 @@ use embedding::brush::{BrushKind, Falloff, Symmetry};
 use embedding::{Point3, Surface};
 use ntori::editor::EditorState;
 use ntori::editor::state::Grab;
-use ntori::io::atomic::{FileError, check_output};
+use ntori::io::atomic::check_new_output;
 use ntori::io::export::Meshing;
 use serde::Serialize;
 
 use super::report::{Report, emit};
 
-/// Sculpt a model without a window: the editor's brushes, one stroke from the command line or
-/// many from a script.
+/// Sculpt a model without a window: the editor's brushes, one stroke or a script of many.
 ///
 /// grab (the default) drags the surface point nearest to --at to --to. With --radius the surface
 /// within R (model units) of it follows, fading out at the radius as --falloff says (smooth: a
@@ -222,10 +221,7 @@ impl Report for SculptReport {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let target = check_output(&args.output, &[&args.model])?;
-    if !args.force && std::fs::symlink_metadata(&target).is_ok() {
-        return Err(FileError::Exists { path: args.output }.into());
-    }
+    check_new_output(&args.output, &[&args.model], args.force)?;
     let strokes = match &args.script {
         Some(script) => read_script(script)?,
         None if args.stroke.at.is_none() => {
@@ -299,6 +295,9 @@ fn read_script(path: &Path) -> anyhow::Result<Vec<StrokeArgs>> {
     Ok(strokes)
 }
 
+/// How far a grab may move its point, in multiples of the model's size ([`EditorState::size`]).
+const MAX_GRAB_REACH: f64 = 10.0;
+
 /// Applies one stroke to the editor's state.
 fn apply(state: &mut EditorState, stroke: &StrokeArgs) -> anyhow::Result<StrokeReport> {
     let at = stroke.at.context("a stroke needs --at")?;
@@ -310,6 +309,13 @@ fn apply(state: &mut EditorState, stroke: &StrokeArgs) -> anyhow::Result<StrokeR
     state.influence = stroke.radius.map_or(0.0, |r| r / state.size());
     let own_pins = state.pins().len();
     let (point, picked_from_at) = nearest(state, at);
+    if picked_from_at > state.size() {
+        eprintln!(
+            "ntori: warning: --at lies {picked_from_at:.4e} from the surface, farther than the \
+             model's size ({:.4e}); the stroke acts at the surface point nearest it",
+            state.size()
+        );
+    }
     let images = state.mirror_images(point).len();
     let mut report = StrokeReport {
         brush: kind.name(),
@@ -325,6 +331,16 @@ fn apply(state: &mut EditorState, stroke: &StrokeArgs) -> anyhow::Result<StrokeR
         let to = stroke
             .to
             .context("the grab brush needs --to (where the point goes)")?;
+        // The drag re-plans at steps of a fraction of the brush, so its time grows with the reach:
+        // refused before any work where no sculpting would go (--to 1e9 had run for minutes).
+        let reach = (to - state.surface_point(point)).norm();
+        if !(reach <= MAX_GRAB_REACH * state.size()) {
+            anyhow::bail!(
+                "--to lies {reach:.4e} from the grabbed point, more than {MAX_GRAB_REACH} times \
+                 the model's size ({:.4e}); grab in smaller steps (several strokes)",
+                state.size()
+            );
+        }
         for &p in &stroke.pin {
             let pin = nearest(state, p).0;
             state.add_pin(pin);

@@ -16,11 +16,13 @@ use super::report::{Report, emit};
 
 /// Tessellate the surface (the paper's t_e/t_r scheme) and check the mesh.
 ///
-/// The coarsest level (t_e = t_r = 1) cuts the surface into 2n + 2 regions, one per chart: a
-/// square in each edge chart, sized so that neighbouring squares' corners meet at the point β, and
-/// two "wheels" (about the inside chart's centre and about the vertex) bounded by the 4n arcs the
+/// The coarsest level (t_e = t_r = 1) cuts the surface into 2n + 2 regions, one per chart: a square
+/// in each edge chart, sized so that neighbouring squares' corners meet at the point β, and two
+/// "wheels" (about the inside chart's centre and about the vertex) bounded by the 4n arcs the
 /// squares leave. t_e divides each square into a t_e × t_e grid and each arc into t_e pieces; t_r
-/// divides the wheels' spokes. Genus 0 uses two wheels, the caps, meeting at the equator.
+/// divides the wheels' spokes (from genus 14 twice or three times as finely, so the rims' 4n·t_e
+/// vertices do not outnumber the rings: the report says how many rings). Genus 0 uses two wheels,
+/// the caps, meeting at the equator.
 ///
 /// Prints V, E, F, the Euler characteristic χ = V − E + F (2 − 2n for genus n), the genus read off
 /// the mesh, components, and checks: closed, manifold, orientable, consistently oriented; no
@@ -58,6 +60,9 @@ pub struct Args {
     /// Also draw the tessellation in the fundamental polygon, charts coloured, to this SVG file.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
+    /// Replace the SVG file if it exists.
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -67,19 +72,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         tr,
         json,
         svg: svg_path,
+        force,
     } = args;
     check_size(genus, te, tr)?;
     if let Some(path) = &svg_path {
-        ntori::io::atomic::check_output(path, &[])?;
+        ntori::io::atomic::check_new_output(path, &[], force)?;
     }
     let atlas =
         Atlas::new(genus).with_context(|| format!("cannot build the charts for genus {genus}"))?;
     let t = atlas
         .tessellate(te, tr)
-        .with_context(|| format!("cannot tessellate genus {genus} at t_e = {te}, t_r = {tr}"))?;
+        .with_context(|| format!("genus {genus} at t_e = {te}, t_r = {tr}"))?;
     let report = report(&atlas, &t)?;
     if let Some(path) = &svg_path {
-        ntori::io::atomic::write_atomically(path, svg(&atlas, &t).as_bytes())?;
+        ntori::io::atomic::write_output(path, svg(&atlas, &t).as_bytes(), force)?;
         // Logged under the target the command line has always used (`ntori`).
         tracing::info!(target: "ntori", path = %path.display(), "wrote the drawing");
     }
@@ -92,6 +98,8 @@ pub struct TessellationReport {
     pub genus: u32,
     pub te: u32,
     pub tr: u32,
+    /// The steps each wheel's spokes take: t_r, or from genus 14 a multiple of it.
+    pub wheel_rings: u32,
     pub vertices: usize,
     pub edges: usize,
     pub faces: usize,
@@ -161,6 +169,7 @@ pub fn report(atlas: &Atlas, t: &Tessellation) -> Result<TessellationReport, mes
         genus,
         te: t.te,
         tr: t.tr,
+        wheel_rings: t.rings,
         vertices: topology.vertices,
         edges: topology.edges,
         faces: topology.faces,
@@ -185,9 +194,14 @@ impl Report for TessellationReport {
         let t = &self.topology;
         let yes = |b: bool| if b { "yes" } else { "NO" };
         let mut s = String::new();
+        let rings = if self.wheel_rings == self.tr {
+            String::new()
+        } else {
+            format!(" (the wheels' spokes in {} steps)", self.wheel_rings)
+        };
         let _ = writeln!(
             s,
-            "genus {}, t_e = {}, t_r = {}",
+            "genus {}, t_e = {}, t_r = {}{rings}",
             self.genus, self.te, self.tr
         );
         let _ = writeln!(

@@ -118,6 +118,28 @@ pub fn check_output(path: &Path, inputs: &[&Path]) -> Result<PathBuf, FileError>
     Ok(target)
 }
 
+/// [`check_output`], and unless `force` the output does not exist yet: what a command checks before
+/// its work, so that it replaces a file only when asked to (`--force`). Returns the target.
+pub fn check_new_output(path: &Path, inputs: &[&Path], force: bool) -> Result<PathBuf, FileError> {
+    let target = check_output(path, inputs)?;
+    if !force && std::fs::symlink_metadata(&target).is_ok() {
+        return Err(FileError::Exists {
+            path: path.to_owned(),
+        });
+    }
+    Ok(target)
+}
+
+/// Writes `bytes` to `path` atomically, replacing a file there only if `force` (otherwise
+/// [`write_new_with`]: a file that appeared while ntori worked is kept).
+pub fn write_output(path: &Path, bytes: &[u8], force: bool) -> Result<(), FileError> {
+    if force {
+        write_atomically(path, bytes)
+    } else {
+        write_new_with(path, |w| w.write_all(bytes))
+    }
+}
+
 /// The file `path` names once its symbolic links are followed (the path itself where it is no
 /// link; a link's target whether or not it exists). Refuses what is not a regular file.
 pub fn resolve_target(path: &Path) -> Result<PathBuf, FileError> {

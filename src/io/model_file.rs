@@ -100,7 +100,7 @@ pub fn from_bytes(path: &Path, bytes: &[u8]) -> Result<Surface, ModelFileError> 
     serde_json::from_slice::<serde::de::IgnoredAny>(bytes).map_err(|e| {
         ModelFileError::NotJson {
             path: path.to_owned(),
-            reason: describe(&e, None),
+            reason: describe(&e, None) + mesh_hint(path),
         }
     })?;
     if bytes.iter().find(|b| !b.is_ascii_whitespace()) != Some(&b'{') {
@@ -164,6 +164,22 @@ fn read_capped(path: &Path) -> Result<Vec<u8>, ModelFileError> {
 }
 
 /// A serde_json error as one line: the field path where known, the problem with long quotes cut,
+
+/// For a file named like a mesh (.obj, .ply, .stl, .glb, .off, .3mf) given where a model belongs:
+/// what makes a model of it.
+fn mesh_hint(path: &Path) -> &'static str {
+    let mesh = path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["obj", "ply", "stl", "glb", "off", "3mf"]
+            .iter()
+            .any(|m| e.eq_ignore_ascii_case(m))
+    });
+    if mesh {
+        " (it looks like a mesh: `ntori fit` makes a model of one)"
+    } else {
+        ""
+    }
+}
+
 /// and the place in the file.
 fn describe(e: &serde_json::Error, field: Option<&str>) -> String {
     let text = e.to_string();

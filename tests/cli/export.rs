@@ -372,12 +372,13 @@ fn assert_close(got: [f64; 3], want: [f64; 3], what: &str) {
     }
 }
 
-/// `ntori export MODEL -o OUT` at t_e = t_r = 6 with `extra` options; what it printed.
+/// `ntori export MODEL -o OUT --force` at t_e = t_r = 6 with `extra` options (the tests export
+/// to one path again and again); what it printed.
 fn coarse_export(model: &Path, out: &Path, extra: &[&str]) -> String {
     let assert = ntori()
         .arg("export")
         .arg(model)
-        .args(["--te", "6", "--tr", "6", "-o"])
+        .args(["--te", "6", "--tr", "6", "--force", "-o"])
         .arg(out)
         .args(extra)
         .assert()

@@ -39,7 +39,7 @@ fn render_refuses_a_tessellation_beyond_the_buffer_limit() {
         .assert()
         .code(1)
         .stderr(predicate::str::contains(
-            "vertex buffer would take 12060721152 bytes",
+            "vertex buffer would take 31388073984 bytes",
         ))
         .stderr(predicate::str::contains("panicked").not());
     assert!(!png.exists());
@@ -178,8 +178,26 @@ fn outputs_write_through_symlinks() {
     let link = dir.path().join("drawing.svg");
     // A relative link, resolved against the link's directory.
     std::os::unix::fs::symlink("real/drawing.svg", &link).unwrap();
+    // The link's target exists: it is refused without --force, and replaced with it.
     ntori()
         .args(["tessellate", "-g", "2", "--te", "1", "--tr", "1", "--svg"])
+        .arg(&link)
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("it exists; pass --force"));
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "old");
+    ntori()
+        .args([
+            "tessellate",
+            "-g",
+            "2",
+            "--te",
+            "1",
+            "--tr",
+            "1",
+            "--force",
+            "--svg",
+        ])
         .arg(&link)
         .assert()
         .success();
@@ -368,7 +386,7 @@ fn sizes_beyond_the_memory_caps_are_refused_before_any_work() {
         .assert()
         .code(1)
         .stderr(predicate::str::contains(
-            "genus 2 at t_e = 1000, t_r = 4 makes 8112000 triangles, about 4.5 GB",
+            "genus 2 at t_e = 1000, t_r = 4 makes 8368000 triangles, about 4.7 GB",
         ))
         .stderr(predicate::str::contains("at most 4000000 triangles"));
     // new: genus 8 at resolution 1024 ran 15 minutes to 10.9 GB; now refused while meshing.
@@ -394,8 +412,10 @@ fn sizes_beyond_the_memory_caps_are_refused_before_any_work() {
         .assert()
         .code(1)
         .stderr(
-            predicate::str::contains("makes 5210112 triangles; a picture may have at most 4000000")
-                .or(predicate::str::contains("max_buffer_size")),
+            predicate::str::contains(
+                "makes 13598720 triangles; a picture may have at most 4000000",
+            )
+            .or(predicate::str::contains("max_buffer_size")),
         );
 }
 

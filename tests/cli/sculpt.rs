@@ -171,6 +171,19 @@ fn sculpt_refuses_what_it_cannot_do() {
             .code(1)
             .stderr(predicates::str::contains(message));
     }
+    // A grab beyond ten times the model's size is refused before any work (its re-planning
+    // steps grow with the reach: --to 1e9 had run for minutes).
+    ntori()
+        .args(["sculpt", &input.display().to_string(), "-o"])
+        .arg(&fresh)
+        .args(["--at", "1,0,0", "--to", "1,0,1e9"])
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicates::str::contains(
+            "more than 10 times the model's size",
+        ));
+    assert!(!fresh.exists());
     // A script's bad line is named by file and line.
     let script = dir.path().join("strokes.txt");
     for (text, message) in [
