@@ -66,6 +66,15 @@ pub struct Args {
     /// If the mesh has several separate pieces, fit the largest (by triangles).
     #[arg(long)]
     largest: bool,
+    /// The file's up axis, turned to the model's +z [default: y for GLB and OBJ, z for the
+    /// others: what `ntori export` writes, so a mesh exported and fitted again keeps its
+    /// orientation].
+    #[arg(long, value_enum, value_name = "AXIS")]
+    up: Option<ntori::io::export::Up>,
+    /// The unit of an OBJ's, PLY's or OFF's numbers (GLB's are metres, STL's millimetres); the
+    /// model's unit is a centimetre, as `ntori export` takes it.
+    #[arg(long, value_enum, default_value_t = ntori::io::export::DEFAULT_UNITS, value_name = "U")]
+    units: ntori::io::export::Units,
     /// Read the mesh as a Catmull–Clark subdivision cage and fit its limit surface (refined and
     /// evaluated by OpenSubdiv), not its polygons; the limit normals are the intended shape's, and
     /// the grid is 32 unless --grid says otherwise.
@@ -121,6 +130,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     import::check_fittable(&valid)
         .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
+    // Into the model's frame only now: the checks above name places as the file has them.
+    let placement = import::Placement::for_file(&args.mesh, args.up, args.units);
+    let (mut valid, mut cage) = (valid, cage);
+    for p in &mut valid.positions {
+        p.coords = placement.place(p.coords, true);
+    }
+    if let Some(c) = &mut cage {
+        for n in &mut c.normals {
+            *n = placement.place(*n, false);
+        }
+    }
     // A cage's limit mesh is as dense as `new`'s plates, so it takes `new`'s grid, one for every
     // chart: the genus-2 slab cage at 20 / 32 fits with patches 0.84% / 0.42% apart, normals
     // 4.5° / 1.6° off its limit normals at the 90th percentile. A user's mesh gets finer disk
@@ -200,6 +220,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }),
         input: InputReport {
             path: args.mesh.display().to_string(),
+            up: placement.up,
+            factor: placement.factor,
             merged_vertices: merged,
             triangulated_polygons: triangulated,
             dropped_components: valid.dropped_components,
@@ -320,6 +342,9 @@ struct FitReport<'a> {
 #[derive(Serialize)]
 struct InputReport {
     path: String,
+    /// The file's up axis (turned to the model's +z) and what one of its units is in model units.
+    up: ntori::io::export::Up,
+    factor: f64,
     merged_vertices: usize,
     triangulated_polygons: usize,
     dropped_components: usize,
@@ -409,6 +434,15 @@ impl Report for FitReport<'_> {
         }
         if i.flipped {
             notes.push("turned right side out".to_string());
+        }
+        if i.up == ntori::io::export::Up::Y {
+            notes.push("its +y up turned to the model's +z".to_string());
+        }
+        if i.factor != 1.0 {
+            notes.push(format!(
+                "a file unit is {} model units (centimetres)",
+                i.factor
+            ));
         }
         if let Some(unused) = i
             .cage

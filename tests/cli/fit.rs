@@ -654,3 +654,48 @@ fn a_cube_is_fitted_with_its_edges_rounded_and_written() {
         "{text}"
     );
 }
+
+/// A model exported to GLB (metres, +y up) and fitted again keeps its size and orientation: the
+/// second export's bounding box is the first's. Read as the file's numbers stand (the old
+/// import), the model came back 100 times smaller and standing on its edge.
+#[test]
+fn an_exported_glb_fitted_again_keeps_its_size_and_orientation() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, model, again) = (
+        dir.path().join("plate.glb"),
+        dir.path().join("plate.json"),
+        dir.path().join("again.glb"),
+    );
+    let size = |model: &std::path::Path, out: &std::path::Path| -> Vec<f64> {
+        let output = ntori()
+            .arg("export")
+            .arg(model)
+            .arg("-o")
+            .arg(out)
+            .assert()
+            .success()
+            .get_output()
+            .stdout
+            .clone();
+        // "… triangles, 0.06000 × 0.007005 × 0.06002 m"
+        let text = String::from_utf8(output).unwrap();
+        let dims = text.rsplit(", ").next().unwrap().trim_end_matches(" m\n");
+        dims.split(" × ").map(|d| d.parse().unwrap()).collect()
+    };
+    let before = size(&asset("models/genus-2.json"), &glb);
+    ntori()
+        .arg("fit")
+        .arg(&glb)
+        .args(["-q", "-o"])
+        .arg(&model)
+        .assert()
+        .success()
+        .stdout(predicate::str::contains(
+            "its +y up turned to the model's +z",
+        ))
+        .stdout(predicate::str::contains("a file unit is 100 model units"));
+    let after = size(&model, &again);
+    for (b, a) in before.iter().zip(&after) {
+        assert!((a - b).abs() <= 0.01 * b, "{before:?} → {after:?}");
+    }
+}

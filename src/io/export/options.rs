@@ -12,7 +12,8 @@ use super::{Encoding, ExportError, Format, SurfaceMesh};
 /// ntori's surfaces are plates whose thin axis is z: z is the model's own up. A Y-up file gets
 /// every point and normal turned by −90° about the x axis, (x, y, z) → (x, z, −y): a rotation
 /// (determinant +1), so triangles keep their winding and normals stay outward.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Up {
     /// +y up: glTF's convention (by its specification), and how Blender and most viewers read OBJ.
     Y,
@@ -27,6 +28,14 @@ impl Up {
         match self {
             Up::Z => v,
             Up::Y => Vector3::new(v.x, v.z, -v.y),
+        }
+    }
+
+    /// The model's vector for `v` read from a file whose up axis is `self` ([`Up::apply`]'s inverse).
+    pub fn unapply(self, v: Vector3) -> Vector3 {
+        match self {
+            Up::Z => v,
+            Up::Y => Vector3::new(v.x, -v.z, v.y),
         }
     }
 }

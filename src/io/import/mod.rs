@@ -32,7 +32,9 @@
 use std::fmt;
 use std::path::Path;
 
-use embedding::Point3;
+use embedding::{Point3, Vector3};
+
+use crate::io::export::Units;
 
 use crate::io::input::{self, InputProblem};
 
@@ -403,4 +405,42 @@ pub(crate) fn text_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, std::borr
         let line = line.strip_suffix(b"\r").unwrap_or(line);
         (i + 1, String::from_utf8_lossy(line))
     })
+}
+
+/// How a mesh file's coordinates become the model's: the file's up axis, and what one of its
+/// units is in model units (a model unit is a centimetre, as `ntori export` writes by default).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub up: crate::io::export::Up,
+    pub factor: f64,
+}
+
+impl Placement {
+    /// The conventions `ntori export` writes `path`'s format with, so that a mesh exported and read
+    /// back keeps its size and orientation: glTF (GLB) is in metres and +y up (its
+    /// specification), STL in millimetres (slicers) and +z up, OBJ +y up (Blender, most viewers),
+    /// PLY and OFF +z up; OBJ, PLY and OFF have no unit, and their numbers are taken in `units`.
+    /// `up` overrides the format's axis.
+    pub fn for_file(path: &Path, up: Option<crate::io::export::Up>, units: Units) -> Placement {
+        use crate::io::export::{Format, Up};
+        let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        // `.gltf` is read as glTF too; the export's formats know only `.glb`.
+        let format = if extension.eq_ignore_ascii_case("gltf") {
+            Some(Format::Glb)
+        } else {
+            Format::from_path(path).ok()
+        };
+        let file_up = format.map_or(Up::Z, Format::default_up);
+        let unit = format.and_then(Format::unit).unwrap_or(units);
+        Placement {
+            up: up.unwrap_or(file_up),
+            factor: unit.metres() / crate::io::export::DEFAULT_UNITS.metres(),
+        }
+    }
+
+    /// A point or vector of the file in the model (`scale`: whether to apply the factor).
+    pub fn place(&self, v: Vector3, scale: bool) -> Vector3 {
+        let v = self.up.unapply(v);
+        if scale { v * self.factor } else { v }
+    }
 }
