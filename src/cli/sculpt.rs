@@ -334,7 +334,7 @@ fn apply(state: &mut EditorState, stroke: &StrokeArgs) -> anyhow::Result<StrokeR
         // The drag re-plans at steps of a fraction of the brush, so its time grows with the reach:
         // refused before any work where no sculpting would go (--to 1e9 had run for minutes).
         let reach = (to - state.surface_point(point)).norm();
-        if !(reach <= MAX_GRAB_REACH * state.size()) {
+        if reach.is_nan() || reach > MAX_GRAB_REACH * state.size() {
             anyhow::bail!(
                 "--to lies {reach:.4e} from the grabbed point, more than {MAX_GRAB_REACH} times \
                  the model's size ({:.4e}); grab in smaller steps (several strokes)",

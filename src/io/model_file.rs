@@ -163,8 +163,6 @@ fn read_capped(path: &Path) -> Result<Vec<u8>, ModelFileError> {
     })
 }
 
-/// A serde_json error as one line: the field path where known, the problem with long quotes cut,
-
 /// For a file named like a mesh (.obj, .ply, .stl, .glb, .off, .3mf) given where a model belongs:
 /// what makes a model of it.
 fn mesh_hint(path: &Path) -> &'static str {
@@ -180,6 +178,7 @@ fn mesh_hint(path: &Path) -> &'static str {
     }
 }
 
+/// A serde_json error as one line: the field path where known, the problem with long quotes cut,
 /// and the place in the file.
 fn describe(e: &serde_json::Error, field: Option<&str>) -> String {
     let text = e.to_string();
