@@ -945,14 +945,7 @@ fn an_exported_mesh_is_placed_back_where_the_model_had_it() {
     use export::{Units, Up};
     use ntori::io::import::Placement;
     let mesh = surface(2, UvLayout::Chart);
-    for format in [
-        Format::Obj,
-        Format::Ply,
-        Format::Stl,
-        Format::Glb,
-        Format::ThreeMf,
-        Format::Off,
-    ] {
+    for format in Format::ALL {
         for (scale, units) in [(1.0, Units::Cm), (2.5, Units::Mm), (0.1, Units::In)] {
             let options = ExportOptions {
                 scale,
