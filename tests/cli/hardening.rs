@@ -187,17 +187,8 @@ fn outputs_write_through_symlinks() {
         .stderr(predicate::str::contains("it exists; pass --force"));
     assert_eq!(std::fs::read_to_string(&target).unwrap(), "old");
     ntori()
-        .args([
-            "tessellate",
-            "-g",
-            "2",
-            "--te",
-            "1",
-            "--tr",
-            "1",
-            "--force",
-            "--svg",
-        ])
+        .args(["tessellate", "-g", "2", "--te", "1", "--tr", "1"])
+        .args(["--force", "--svg"])
         .arg(&link)
         .assert()
         .success();
