@@ -120,7 +120,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     ntori::io::atomic::check_new_output(&args.output, &[&args.mesh], args.force)?;
     let read = import::read_mesh(&args.mesh)?;
     let (merged, triangulated) = (read.merged_vertices, read.triangulated_polygons);
-    let (valid, cage) = if args.cage {
+    let (mut valid, mut cage) = if args.cage {
         let (valid, cage) = read_cage(&args.mesh, read, args.cage_level)?;
         (valid, Some(cage))
     } else {
@@ -132,14 +132,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
     // Into the model's frame only now: the checks above name places as the file has them.
     let placement = import::Placement::for_file(&args.mesh, args.up, args.units);
-    let (mut valid, mut cage) = (valid, cage);
-    for p in &mut valid.positions {
-        p.coords = placement.place(p.coords, true);
-    }
+    placement.place_points(&mut valid.positions);
     if let Some(c) = &mut cage {
-        for n in &mut c.normals {
-            *n = placement.place(*n, false);
-        }
+        c.normals
+            .iter_mut()
+            .for_each(|n| *n = placement.direction(*n));
     }
     // A cage's limit mesh is as dense as `new`'s plates, so it takes `new`'s grid, one for every
     // chart: the genus-2 slab cage at 20 / 32 fits with patches 0.84% / 0.42% apart, normals

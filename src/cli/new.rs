@@ -33,9 +33,9 @@ use super::{FitArgs, FitProgress, GenusArg};
 /// both show (a ripple's cause; at most 1% of the diagonal); the largest principal curvature |κ|
 /// against the intended shape's own peak, from its closed form (a crease or spike; at most 3×); the
 /// angle between the surface's normal and the intended shape's exact normal at the input mesh's
-/// vertices (median and 90th percentile; at most 5° at the 90th); and crossing triangles of the t_e
-/// = t_r = 32 tessellation, or of 48 or 64 where 32's triangles are too coarse to tell (none). From
-/// genus 2 it also reports, unchecked, how flat the plate's flat faces came out: their mean
+/// vertices (median and 90th percentile; at most 5° at the 90th); and crossing triangles of the
+/// t_e = t_r = 32 tessellation, or of 48 or 64 where 32's triangles are too coarse to tell (none).
+/// From genus 2 it also reports, unchecked, how flat the plate's flat faces came out: their mean
 /// curvature |H| (median, 90th percentile, and that times the half-thickness) and the normals'
 /// angle from ±z.
 ///

@@ -128,15 +128,12 @@ impl Jobs {
         );
         self.spawn(format!("importing {name}"), move || {
             let read = import::read_mesh(&path).map_err(|e| JobError::Import(e.to_string()))?;
-            let valid = import::validate(read, false)
+            let mut valid = import::validate(read, false)
                 .and_then(|valid| import::check_fittable(&valid).map(|()| valid))
                 .map_err(|e| JobError::Import(format!("{}: {e}", path.display())))?;
             // In the model's frame, as `ntori fit` places it by the format's conventions.
-            let placement = import::Placement::for_file(&path, None, export::DEFAULT_UNITS);
-            let mut valid = valid;
-            for p in &mut valid.positions {
-                p.coords = placement.place(p.coords, true);
-            }
+            import::Placement::for_file(&path, None, export::DEFAULT_UNITS)
+                .place_points(&mut valid.positions);
             // `ntori fit`'s settings.
             let (settings, fit_settings) = mesh_fit::default_settings(valid.genus);
             let fit = fit_user_mesh(

@@ -163,15 +163,10 @@ fn read_capped(path: &Path) -> Result<Vec<u8>, ModelFileError> {
     })
 }
 
-/// For a file named like a mesh (.obj, .ply, .stl, .glb, .off, .3mf) given where a model belongs:
-/// what makes a model of it.
+/// For a file named like a mesh (any of the export formats' extensions) given where a model
+/// belongs: what makes a model of it.
 fn mesh_hint(path: &Path) -> &'static str {
-    let mesh = path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
-        ["obj", "ply", "stl", "glb", "off", "3mf"]
-            .iter()
-            .any(|m| e.eq_ignore_ascii_case(m))
-    });
-    if mesh {
+    if crate::io::export::Format::from_path(path).is_ok() {
         " (it looks like a mesh: `ntori fit` makes a model of one)"
     } else {
         ""

@@ -958,9 +958,13 @@ fn an_exported_mesh_is_placed_back_where_the_model_had_it() {
             // unit), the model comes back at its physical size in centimetres: as it was at a
             // scale of 1 cm, `scale` × `units` larger otherwise.
             let placement = Placement::for_file(&path, None, units);
-            for (p, q) in mesh.positions.iter().zip(&placed.positions) {
-                let back = placement.place(q.coords, true);
-                let want = p.coords * scale * units.metres() / Units::Cm.metres();
+            let mut back = placed.positions.clone();
+            placement.place_points(&mut back);
+            for (p, back) in mesh.positions.iter().zip(&back) {
+                let (back, want) = (
+                    back.coords,
+                    p.coords * scale * units.metres() / Units::Cm.metres(),
+                );
                 assert!(
                     (back - want).norm() <= 1e-9 * want.norm().max(1.0),
                     "{format:?} {scale} {units:?}: {p:?} came back as {back:?}, want {want:?}"

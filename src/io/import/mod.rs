@@ -438,9 +438,15 @@ impl Placement {
         }
     }
 
-    /// A point or vector of the file in the model (`scale`: whether to apply the factor).
-    pub fn place(&self, v: Vector3, scale: bool) -> Vector3 {
-        let v = self.up.unapply(v);
-        if scale { v * self.factor } else { v }
+    /// The file's points, in place, in the model: turned and scaled.
+    pub fn place_points(&self, points: &mut [Point3]) {
+        for p in points {
+            p.coords = self.up.unapply(p.coords) * self.factor;
+        }
+    }
+
+    /// A direction of the file (a normal) in the model: turned only.
+    pub fn direction(&self, v: Vector3) -> Vector3 {
+        self.up.unapply(v)
     }
 }
