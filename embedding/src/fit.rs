@@ -71,6 +71,9 @@ pub struct Parameterization {
     /// Rounds of the sphere's map solved in the plane to even its area out, where they were taken
     /// (genus 0's long limbs; not the evening of a mesh of thin triangles); 0 elsewhere.
     pub planar_rounds: usize,
+    /// Rounds of the sphere's density-equalizing flow whose map was taken (0: none, or not the
+    /// sphere).
+    pub equalizing_rounds: usize,
     /// Newton's solve of the map, over every reweighting round (`None` for the sphere, whose map is
     /// relaxed by sweeps, or solved in the plane in its planar rounds).
     pub newton: Option<Convergence>,
@@ -1497,6 +1500,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
         folded: 0,
         sweeps: 0,
         planar_rounds: 0,
+        equalizing_rounds: 0,
         newton: None,
         map_distortion: None,
     }
@@ -1549,6 +1553,7 @@ fn flatten(
         folded,
         sweeps: solved.sweeps,
         planar_rounds: 0,
+        equalizing_rounds: 0,
         newton: Some(solved),
         map_distortion: None,
     })

@@ -396,6 +396,7 @@ fn finish(
             folded: mapped.folded,
             sweeps: mapped.sweeps,
             planar_rounds: mapped.planar_rounds,
+            equalizing_rounds: mapped.equalizing_rounds,
             newton: mapped.solved,
             map_distortion: mapped.distortion,
         },
@@ -689,6 +690,8 @@ struct Mapped {
     sweeps: usize,
     /// Rounds of the sphere's map solved in the plane (0 elsewhere).
     planar_rounds: usize,
+    /// Rounds of the sphere's density-equalizing flow taken (0 elsewhere).
+    equalizing_rounds: usize,
     /// Newton's solve of the polygon's map (none for the sphere's).
     solved: Option<Convergence>,
     /// The map's distortion (the polygon's or the sphere's).
@@ -732,6 +735,7 @@ fn map_to_sphere(
         folded: map.folded,
         sweeps: map.sweeps,
         planar_rounds: map.planar_rounds,
+        equalizing_rounds: map.equalizing_rounds,
         solved: None,
         distortion: map.distortion,
         loops: LoopReport {
@@ -846,6 +850,7 @@ fn map_to_polygon(
         folded,
         sweeps,
         planar_rounds: 0,
+        equalizing_rounds: 0,
         solved: Some(solved),
         distortion,
         loops,

@@ -225,6 +225,8 @@ pub struct NewReport {
     pub sweeps: usize,
     /// Rounds of the sphere's map solved in the plane to even its area out, where taken.
     pub planar_rounds: usize,
+    /// Rounds of the sphere's density-equalizing flow, where taken.
+    pub equalizing_rounds: usize,
     pub newton: Option<embedding::harmonic::Convergence>,
     /// How far the map onto the polygon is from conformal and area-preserving (plates only: it is
     /// measured on their cut disk).
@@ -638,6 +640,7 @@ pub fn check(
         control_points: surface.control_points().len(),
         sweeps: parameterization.sweeps,
         planar_rounds: parameterization.planar_rounds,
+        equalizing_rounds: parameterization.equalizing_rounds,
         newton: parameterization.newton,
         distortion: parameterization.distortion(positions, surface.atlas().geometry()),
         folded_triangles: parameterization.folded,
@@ -769,12 +772,26 @@ impl NewReport {
     /// How the map was solved, in words.
     fn solve_text(&self) -> String {
         match self.newton {
-            None if self.planar_rounds > 0 => format!(
-                "{}, then {}",
-                count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
-                count(self.planar_rounds, "planar round", "planar rounds")
-            ),
-            None => count(self.sweeps, "relaxation sweep", "relaxation sweeps"),
+            None => {
+                let mut text = count(self.sweeps, "relaxation sweep", "relaxation sweeps");
+                let later = [
+                    (self.planar_rounds, "planar round", "planar rounds"),
+                    (
+                        self.equalizing_rounds,
+                        "equalizing round",
+                        "equalizing rounds",
+                    ),
+                ];
+                let later: Vec<String> = later
+                    .into_iter()
+                    .filter(|&(n, _, _)| n > 0)
+                    .map(|(n, one, many)| count(n, one, many))
+                    .collect();
+                if !later.is_empty() {
+                    text = format!("{text}, then {}", later.join(" and "));
+                }
+                text
+            }
             Some(n) => format!(
                 "{} and {} ({}, residual {:.0e}){}",
                 count(self.sweeps, "sweep", "sweeps"),
