@@ -55,6 +55,9 @@ use crate::surface::Point3;
 use faer::prelude::*;
 use faer::sparse::{SparseColMat, Triplet};
 
+/// Each vertex's neighbours with their weights, (weight, neighbour), as the sweeps take them.
+type Neighbours = Vec<Vec<(f64, u32)>>;
+
 /// Every vertex of a genus-0 mesh on the unit sphere.
 #[derive(Clone, Debug)]
 pub(crate) struct SphereMap {
@@ -496,7 +499,7 @@ fn even_out(
     positions: &[Point3],
     triangles: &[[u32; 3]],
     areas: &[f64],
-) -> Result<(usize, Vec<Vec<(f64, u32)>>), EmbeddingError> {
+) -> Result<(usize, Neighbours), EmbeddingError> {
     let area_mean = |points: &[Vector3<f64>]| {
         distortion(points, positions, triangles).map_or(f64::INFINITY, |d| d.area_mean)
     };
