@@ -1013,7 +1013,8 @@ fn an_imported_mesh_becomes_an_untitled_model() {
     assert!(!state.is_modified());
     assert_eq!(
         state.settings(),
-        embedding::mesh_fit::default_settings(0).0,
+        // The dumbbell's 642 vertices.
+        embedding::mesh_fit::default_settings(0, 642).0,
         "{messages}"
     );
     assert!(

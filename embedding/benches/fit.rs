@@ -173,7 +173,7 @@ fn plate_fit(genus: u32) -> embedding::fit::InitialFit {
 
 /// `ntori fit`'s fit of a genus-4 plate mesh, checked to map without a fold.
 fn genus4_mesh_fit(mesh: &HoledMesh) -> mesh_fit::MeshFit {
-    let (settings, fit_settings) = mesh_fit::default_settings(4);
+    let (settings, fit_settings) = mesh_fit::default_settings(4, mesh.positions.len());
     let fit = mesh_model(
         &mesh.positions,
         &mesh.triangles,

@@ -78,7 +78,7 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
     // χ = V − E + F with E = 3F/2 on a closed triangle mesh.
     let euler = positions.len() as i64 - triangles.len() as i64 / 2;
     let genus = u32::try_from((2 - euler) / 2).expect("a closed orientable mesh");
-    let (defaults, fit_defaults) = mesh_fit::default_settings(genus);
+    let (defaults, fit_defaults) = mesh_fit::default_settings(genus, positions.len());
     let grid = env("GRID").map_or(defaults.grid, |g| g as usize);
     let settings = SplineSettings {
         grid,

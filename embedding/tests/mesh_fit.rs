@@ -353,7 +353,7 @@ fn assert_fits_within_issue_14s_targets(
     triangles: &[[u32; 3]],
 ) -> embedding::mesh_fit::MeshFit {
     use embedding::quality;
-    let (settings, fit_settings) = embedding::mesh_fit::default_settings(genus);
+    let (settings, fit_settings) = embedding::mesh_fit::default_settings(genus, positions.len());
     let fit = mesh_model(positions, triangles, settings, fit_settings, &|_| {}).unwrap();
     assert_eq!((fit.genus, fit.parameterization.folded), (genus, 0));
     let diagonal = fit.mesh_diagonal;
@@ -431,7 +431,7 @@ fn irregular_meshes_of_other_shapes_fit_without_folds() {
 fn a_raw_marching_tetrahedra_mesh_fits_through_the_closer_of_two_maps() {
     use embedding::quality;
     let (positions, triangles) = shapes::pretzel(0.12);
-    let (settings, fit_settings) = embedding::mesh_fit::default_settings(3);
+    let (settings, fit_settings) = embedding::mesh_fit::default_settings(3, positions.len());
     let fit = mesh_model(&positions, &triangles, settings, fit_settings, &|_| {}).unwrap();
     assert_eq!((fit.genus, fit.parameterization.folded), (3, 0));
     assert_eq!(fit.loops.bases_screened, 32);
@@ -517,7 +517,7 @@ fn a_cad_gear_with_needle_walls_fits_fair_once_its_long_edges_are_split() {
     use embedding::mesh_fit::fit_user_mesh;
     use embedding::quality;
     let (positions, triangles) = shapes::needle_gear(120, 10.0, 0.8);
-    let (settings, fit_settings) = embedding::mesh_fit::default_settings(1);
+    let (settings, fit_settings) = embedding::mesh_fit::default_settings(1, positions.len());
     let user = fit_user_mesh(&positions, &triangles, settings, fit_settings, &|_| {}).unwrap();
     let split = user
         .split
@@ -611,7 +611,7 @@ fn a_box_of_twelve_triangles_fits_as_a_rounded_box() {
         .iter()
         .flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
         .collect();
-    let (settings, fit_settings) = embedding::mesh_fit::default_settings(0);
+    let (settings, fit_settings) = embedding::mesh_fit::default_settings(0, positions.len());
     let user = fit_user_mesh(&positions, &triangles, settings, fit_settings, &|_| {}).unwrap();
     let split = user.split.as_ref().expect("every edge of the box is long");
     let fit = &user.fit;
@@ -644,7 +644,7 @@ fn a_box_of_twelve_triangles_fits_as_a_rounded_box() {
 fn edge_middles_bring_a_coarse_tube_closer_between_its_vertices() {
     use embedding::quality;
     let (positions, triangles) = shapes::trefoil_tube(160, 16, 0.45);
-    let (settings, fit_settings) = embedding::mesh_fit::default_settings(1);
+    let (settings, fit_settings) = embedding::mesh_fit::default_settings(1, positions.len());
     let fit = |edge_samples: f64, raise_smoothness: bool| {
         let fit_settings = FitSettings {
             edge_samples,

@@ -153,7 +153,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         args.spline.settings(
             valid.genus,
-            mesh_fit_grid(valid.genus),
+            mesh_fit_grid(valid.genus, valid.positions.len()),
             |grid| mesh_fit_disk_grid(valid.genus, grid),
             embedding::fit::default_smoothness,
             |_| 0.0,

@@ -135,7 +135,8 @@ impl Jobs {
             import::Placement::for_file(&path, None, export::DEFAULT_UNITS)
                 .place_points(&mut valid.positions);
             // `ntori fit`'s settings.
-            let (settings, fit_settings) = mesh_fit::default_settings(valid.genus);
+            let (settings, fit_settings) =
+                mesh_fit::default_settings(valid.genus, valid.positions.len());
             let fit = fit_user_mesh(
                 &valid.positions,
                 &valid.triangles,
