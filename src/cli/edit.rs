@@ -81,6 +81,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         screenshot_on_exit,
         ..Default::default()
     };
+    no_display_is_an_error()?;
     ntori::editor::run(options).map_err(|e| anyhow::anyhow!("the editor failed: {e}"))?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// On Linux and the BSDs the editor needs an X11 or Wayland display; without one winit fails deep
+/// inside its event loop with a message naming its own source file. Said plainly instead, before
+/// the model is loaded into a window that cannot open.
+fn no_display_is_an_error() -> anyhow::Result<()> {
+    if !cfg!(all(unix, not(target_os = "macos"))) {
+        return Ok(());
+    }
+    let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+    if ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+        .into_iter()
+        .any(set)
+    {
+        return Ok(());
+    }
+    anyhow::bail!(
+        "the editor needs a display, and neither DISPLAY nor WAYLAND_DISPLAY is set: run it in a \
+         desktop session, or under a virtual one (xvfb-run ntori edit …); `ntori render` and \
+         `ntori sculpt` work without one"
+    )
 }

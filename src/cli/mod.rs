@@ -79,13 +79,17 @@ struct GenusArg {
     genus: u32,
 }
 
-/// A genus: a whole number 0 or more. (Above 64 the charts say "not supported" with the limit;
-/// clap's own u32 parser would answer -1 with the range 0..=4294967295.)
+/// A genus: a whole number from 0 to 64, refused as a usage error (exit status 2) either way out
+/// of range, as -1 and 65 alike are mistakes on the command line. (clap's own u32 parser would
+/// answer -1 with the range 0..=4294967295.)
 fn parse_genus(s: &str) -> Result<u32, String> {
     let max = charts::MAX_GENUS;
     match s.trim().parse::<i64>() {
         Ok(n) if n < 0 => Err(format!("a genus is 0 or more (0 to {max}), got {n}")),
-        Ok(n) => u32::try_from(n).map_err(|_| format!("genus {n} is not supported (0 to {max})")),
+        Ok(n) if n > i64::from(max) => Err(format!(
+            "genus {n} is not supported: the charts are built and validated for genus 0 to {max}"
+        )),
+        Ok(n) => Ok(n as u32),
         Err(_) => Err(format!(
             "a genus is a whole number from 0 to {max}, got {s:?}"
         )),
@@ -97,8 +101,9 @@ fn parse_genus(s: &str) -> Result<u32, String> {
 struct FitArgs {
     /// Control points per side of each chart's grid [default: for new 32 for the sphere and the
     /// torus and 48 from genus 2 (a coarser grid ripples there), but 40 from genus 5 to 16 (whose
-    /// disk charts take the finer grids) and 64 at genus 30 to 32; for fit 40, and 80 for a genus-0 mesh (its two
-    /// charts carry the whole surface); 32 for fit --cage]
+    /// disk charts take the finer grids) and 64 at genus 30 to 32; for fit 40, and for a genus-0 mesh (its two
+    /// charts carry the whole surface) 80, raised to at most 128 until there is a control point per
+    /// vertex; 32 for fit --cage]
     #[arg(long, value_name = "G", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(4..=MAX_GRID))]
     grid: Option<u64>,
     /// Control points per side of the disk charts' grids (the inside and vertex charts, which

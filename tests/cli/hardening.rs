@@ -1122,3 +1122,19 @@ fn a_failing_fit_leaves_its_output_alone() {
         .stderr(predicate::str::contains("it is the input"));
     assert_eq!(std::fs::read(torus).unwrap(), input);
 }
+
+/// Without a display the editor says so plainly, exit status 1, rather than winit's error naming
+/// its own source file.
+#[test]
+fn the_editor_without_a_display_says_what_it_needs() {
+    ntori()
+        .arg("edit")
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .timeout(std::time::Duration::from_secs(60))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("the editor needs a display"))
+        .stderr(predicate::str::contains("winit").not());
+}

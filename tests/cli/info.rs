@@ -43,7 +43,7 @@ fn unsupported_genus_is_a_clear_error() {
     ntori()
         .args(["info", "--genus", "65"])
         .assert()
-        .code(1)
+        .code(2)
         .stderr(predicate::str::contains("genus 65 is not supported"))
         .stderr(predicate::str::contains("panicked").not());
 }
