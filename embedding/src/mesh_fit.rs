@@ -125,8 +125,9 @@ pub fn mesh_fit_disk_grid(genus: u32, grid: usize) -> Option<usize> {
 }
 
 /// `ntori fit`'s spline and fit settings for a genus-`genus` mesh of `vertices` vertices where none
-/// are chosen: [`mesh_fit_grid`] (40; 80 to 128 for genus 0), disk charts at [`mesh_fit_disk_grid`] (80 from genus
-/// 2), the default degree and continuity, and the grid's smoothness weight (2e-3).
+/// are chosen: [`mesh_fit_grid`] (40; 80 to 128 for genus 0), disk charts at
+/// [`mesh_fit_disk_grid`] (80 from genus 2), the default degree and continuity, and the grid's
+/// smoothness weight (2e-3).
 ///
 /// Until session 28 this was one grid of 20 with λ = 1e-4: at 32 with that weight the coarse plate
 /// asset had overfitted (|κ| up to 178). With the stronger weight that a finer grid needs and the
