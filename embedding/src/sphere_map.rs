@@ -205,9 +205,9 @@ const MAX_STRAIN: f64 = 0.1;
 
 /// After each round every vertex takes this fraction of its step to its neighbours' weighted mean,
 /// with the weights the map was last solved with (one Gauss–Seidel sweep). The flow governs area
-/// only: without the sweep, thin triangles sheared into needles
-/// within a few rounds (the bunny: the largest σ₁/σ₂ from 32 to 500 in 10 rounds); with it the
-/// same map reached areas ×20 at worst with σ₁/σ₂ at most 77.
+/// only: without the sweep, thin triangles sheared into needles within a few rounds (the bunny:
+/// the largest σ₁/σ₂ from 32 to 500 in 10 rounds); with it the same map reached areas ×20 at
+/// worst with σ₁/σ₂ at most 77.
 const SHEAR_DAMPING: f64 = 0.3;
 
 /// The largest σ₁/σ₂ of a map [`equalize_areas`] keeps (or the map's own at the start, if larger);
@@ -984,6 +984,26 @@ mod tests {
         areas
     }
 
+    /// A mesh's vertex areas, mean value weights and first map.
+    struct Conformal {
+        areas: Vec<f64>,
+        weights: Vec<Vec<(u32, f64)>>,
+        map: Vec<Vector3<f64>>,
+    }
+
+    /// The mesh's [`Conformal`] start: Floater's map punctured at the largest triangle.
+    fn conformal_map(positions: &[Point3], triangles: &[[u32; 3]]) -> Conformal {
+        let areas = vertex_areas(positions, triangles);
+        let weights = floater::mean_value_weights(positions, triangles).unwrap();
+        let removed = largest_triangle(positions, triangles).unwrap();
+        let map = initial_map(triangles, &areas, &weights, removed).unwrap();
+        Conformal {
+            areas,
+            weights,
+            map,
+        }
+    }
+
     /// A round body with an arm each way along x (radius 1 + arm·|x|¹²): the conformal map squeezes
     /// the arms' ends, ×6 and ×9 on average for arms of 4 and 6. Evened out in the plane, each
     /// round taken leaves no fold and a mean at least [`EVEN_GAIN`] lower, so the map comes out
@@ -994,10 +1014,11 @@ mod tests {
             let (positions, _, triangles) = lat_long(48, 48, |d| {
                 Point3::from(d * (1.0 + arm * d.x.abs().powi(12)))
             });
-            let areas = vertex_areas(&positions, &triangles);
-            let weights = floater::mean_value_weights(&positions, &triangles).unwrap();
-            let removed = largest_triangle(&positions, &triangles).unwrap();
-            let start = initial_map(&triangles, &areas, &weights, removed).unwrap();
+            let Conformal {
+                areas,
+                weights,
+                map: start,
+            } = conformal_map(&positions, &triangles);
             let mut points = start.clone();
             let (rounds, _) =
                 even_out(&mut points, &weights, &positions, &triangles, &areas).unwrap();
@@ -1021,17 +1042,19 @@ mod tests {
     /// The body with long arms of `long_arms_are_evened_out_in_the_plane_without_a_fold`, from its
     /// conformal map (the Floater map's, whose pins stretch even the round sphere's): the flow
     /// leaves no fold, keeps σ₁/σ₂ within its bound and takes the largest area ratio down to a
-    /// tenth or less, or within ×1.1 (measured: no arm ×3.4 → ×1.02, arms of 4 ×86 → ×5.6, of 6 ×142 → ×9.0).
+    /// tenth or less, or within ×1.1 (measured: no arm ×3.4 → ×1.02, arms of 4 ×86 → ×5.6, of 6
+    /// ×142 → ×9.0).
     #[test]
     fn the_flow_spreads_squeezed_arms_without_a_fold() {
         for arm in [0.0, 4.0, 6.0] {
             let (positions, _, triangles) = lat_long(48, 48, |d| {
                 Point3::from(d * (1.0 + arm * d.x.abs().powi(12)))
             });
-            let areas = vertex_areas(&positions, &triangles);
-            let weights = floater::mean_value_weights(&positions, &triangles).unwrap();
-            let removed = largest_triangle(&positions, &triangles).unwrap();
-            let start = initial_map(&triangles, &areas, &weights, removed).unwrap();
+            let Conformal {
+                weights,
+                map: start,
+                ..
+            } = conformal_map(&positions, &triangles);
             assert_eq!(folded_triangles(&start, &triangles), 0, "arm {arm}");
             let neighbours: Vec<Vec<(f64, u32)>> = weights
                 .iter()
@@ -1066,10 +1089,7 @@ mod tests {
         let (positions, _, triangles) = lat_long(48, 48, |d| {
             Point3::from(d * (1.0 + 6.0 * d.dot(&axis).abs().powi(12)))
         });
-        let areas = vertex_areas(&positions, &triangles);
-        let weights = floater::mean_value_weights(&positions, &triangles).unwrap();
-        let removed = largest_triangle(&positions, &triangles).unwrap();
-        let mut points = initial_map(&triangles, &areas, &weights, removed).unwrap();
+        let mut points = conformal_map(&positions, &triangles).map;
         // The arms' ends: the vertices farthest along the axis either way.
         let end = |sign: f64| {
             (0..positions.len())
