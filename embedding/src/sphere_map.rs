@@ -53,6 +53,7 @@ use crate::fit::{Distortion, relative_stretch, stretch_divisor, triangle_distort
 use crate::floater;
 use crate::surface::Point3;
 use faer::prelude::*;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 
 /// Each vertex's neighbours with their weights, (weight, neighbour), as the sweeps take them.
@@ -169,12 +170,12 @@ pub(crate) fn sphere_map(
     // ratio rose from ×2.7 to ×3.6 while the largest fell).
     let mut equalized = 0;
     if folded == 0 {
-        equalized = equalize_areas(&mut points, &neighbours, positions, triangles);
+        equalized = equalize_areas(&mut points, &neighbours, positions, triangles, areas);
         if equalized > 0 {
             distortion = self::distortion(&points, positions, triangles);
         }
     }
-    seam_through_squeezed(&mut points, positions, triangles);
+    seam_through_squeezed(&mut points, triangles, areas);
     Ok(SphereMap {
         distortion,
         points,
@@ -230,27 +231,25 @@ const STEP_HALVINGS: usize = 12;
 /// keeps the triangles' shapes ([`SHEAR_DAMPING`]).
 /// Squeezed parts spread, and the stretched parts round them give them room. Of the maps made, the
 /// one with the smallest largest area ratio whose σ₁/σ₂ stays within [`EQUALIZE_ANGLE_BOUND`] is
-/// kept: returns its round (0: `points` unchanged). `points` must fold no triangle; no round folds
-/// one.
+/// kept: returns its round (0: `points` unchanged). `areas` are the mesh's vertex areas
+/// ([`crate::fit::vertex_areas`]). `points` must fold no triangle; no round folds one.
 fn equalize_areas(
     points: &mut [Vector3<f64>],
     neighbours: &[Vec<(f64, u32)>],
     positions: &[Point3],
     triangles: &[[u32; 3]],
+    areas: &[f64],
 ) -> usize {
     let Some(start) = distortion(points, positions, triangles) else {
         return 0;
     };
-    let surface_mass = vertex_areas(points.len(), triangles, |t| {
-        let [a, b, c] = t.map(|v| positions[v as usize]);
-        (b - a).cross(&(c - a)).norm() / 6.0
-    });
+    let mut analysis = None;
     let angle_bound = EQUALIZE_ANGLE_BOUND.max(start.angle_max);
     let mut best = (start.area_max, points.to_vec(), 0);
     for round in 1..=EQUALIZE_ROUNDS {
         // The flow only improves a map that is already a bijection: where its system cannot be
         // solved (a vertex whose triangles have no area on the surface) it stops, keeping the best.
-        let Ok(field) = diffused_log_ratio(points, triangles, &surface_mass) else {
+        let Ok(field) = diffused_log_ratio(points, triangles, areas, &mut analysis) else {
             break;
         };
         if !field.iter().all(|g| g.is_finite()) {
@@ -284,16 +283,14 @@ fn equalize_areas(
     best.2
 }
 
-/// Per vertex, the sum of `third(t)` over its triangles t.
-fn vertex_areas(
-    count: usize,
-    triangles: &[[u32; 3]],
-    third: impl Fn(&[u32; 3]) -> f64,
-) -> Vec<f64> {
-    let mut areas = vec![0.0; count];
+/// Per vertex, a third of its triangles' chord areas on the sphere: the map's counterpart of the
+/// mesh's vertex areas ([`crate::fit::vertex_areas`]).
+fn chord_areas(points: &[Vector3<f64>], triangles: &[[u32; 3]]) -> Vec<f64> {
+    let mut areas = vec![0.0; points.len()];
     for t in triangles {
-        let a = third(t);
-        t.iter().for_each(|&v| areas[v as usize] += a);
+        let [a, b, c] = t.map(|v| points[v as usize]);
+        let third = (b - a).cross(&(c - a)).norm() / 6.0;
+        t.iter().for_each(|&v| areas[v as usize] += third);
     }
     areas
 }
@@ -307,12 +304,10 @@ fn diffused_log_ratio(
     points: &[Vector3<f64>],
     triangles: &[[u32; 3]],
     surface_mass: &[f64],
+    analysis: &mut Option<SymbolicLlt<usize>>,
 ) -> Result<Vec<f64>, EmbeddingError> {
     let n = points.len();
-    let sphere_mass = vertex_areas(n, triangles, |t| {
-        let [a, b, c] = t.map(|v| points[v as usize]);
-        (b - a).cross(&(c - a)).norm() / 6.0
-    });
+    let sphere_mass = chord_areas(points, triangles);
     let surface_total: f64 = surface_mass.iter().sum();
     let sphere_total: f64 = sphere_mass.iter().sum();
     let time = DIFFUSION_TIME * surface_total;
@@ -336,8 +331,18 @@ fn diffused_log_ratio(
     let failed = |e: String| EmbeddingError::Parameterization(format!("equalizing areas: {e}"));
     let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
         .map_err(|e| failed(format!("{e:?}")))?;
-    let factor = matrix
-        .sp_cholesky(faer::Side::Lower)
+    // Every round's matrix has the same pattern (the mesh's edges, zero weights included), so its
+    // ordering and symbolic factorisation are made once.
+    let symbolic = match analysis {
+        Some(symbolic) => symbolic.clone(),
+        None => analysis
+            .insert(
+                SymbolicLlt::try_new(matrix.symbolic(), faer::Side::Lower)
+                    .map_err(|e| failed(format!("{e:?}")))?,
+            )
+            .clone(),
+    };
+    let factor = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), faer::Side::Lower)
         .map_err(|e| failed(format!("{e:?}")))?;
     let rhs = Mat::<f64>::from_fn(n, 1, |v, _| {
         let ratio = (surface_mass[v] / surface_total)
@@ -440,20 +445,9 @@ fn damp_shear(points: &mut [Vector3<f64>], neighbours: &[Vec<(f64, u32)>], trian
 /// ratio where above 1), have the largest moment of inertia: the eigenvector of the smallest
 /// eigenvalue of Σ w x xᵀ. On the bunny, on its own, this took the fit's distance from 3.9% to
 /// 2.5% of the diagonal, and after an earlier form of the flow from 2.4% to 1.2%.
-fn seam_through_squeezed(
-    points: &mut [Vector3<f64>],
-    positions: &[Point3],
-    triangles: &[[u32; 3]],
-) {
+fn seam_through_squeezed(points: &mut [Vector3<f64>], triangles: &[[u32; 3]], surface: &[f64]) {
     let n = points.len();
-    let surface = vertex_areas(n, triangles, |t| {
-        let [a, b, c] = t.map(|v| positions[v as usize]);
-        (b - a).cross(&(c - a)).norm()
-    });
-    let sphere = vertex_areas(n, triangles, |t| {
-        let [a, b, c] = t.map(|v| points[v as usize]);
-        (b - a).cross(&(c - a)).norm()
-    });
+    let sphere = chord_areas(points, triangles);
     let (surface_total, sphere_total) = (surface.iter().sum::<f64>(), sphere.iter().sum::<f64>());
     let mut scatter = nalgebra::Matrix3::zeros();
     for v in 0..n {
@@ -924,6 +918,7 @@ fn stretch(points: &[Vector3<f64>], positions: &[Point3], triangles: &[[u32; 3]]
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::vertex_areas;
 
     /// A latitude–longitude sphere of radius `radius` stretched by `stretch` along x, and its
     /// vertices' directions (unit vectors), which are where a map onto the sphere would put them.
@@ -971,17 +966,6 @@ mod tests {
         }
         let positions = directions.iter().map(|&d| shape(d)).collect();
         (positions, directions, triangles)
-    }
-
-    /// Each vertex's third of its triangles' areas.
-    fn vertex_areas(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<f64> {
-        let mut areas = vec![0.0; positions.len()];
-        for t in triangles {
-            let [a, b, c] = t.map(|v| positions[v as usize]);
-            let third = (b - a).cross(&(c - a)).norm() / 6.0;
-            t.iter().for_each(|&v| areas[v as usize] += third);
-        }
-        areas
     }
 
     /// A mesh's vertex areas, mean value weights and first map.
@@ -1051,9 +1035,9 @@ mod tests {
                 Point3::from(d * (1.0 + arm * d.x.abs().powi(12)))
             });
             let Conformal {
+                areas,
                 weights,
                 map: start,
-                ..
             } = conformal_map(&positions, &triangles);
             assert_eq!(folded_triangles(&start, &triangles), 0, "arm {arm}");
             let neighbours: Vec<Vec<(f64, u32)>> = weights
@@ -1061,7 +1045,7 @@ mod tests {
                 .map(|list| list.iter().map(|&(u, w)| (w, u)).collect())
                 .collect();
             let mut points = start.clone();
-            let round = equalize_areas(&mut points, &neighbours, &positions, &triangles);
+            let round = equalize_areas(&mut points, &neighbours, &positions, &triangles, &areas);
             let before = distortion(&start, &positions, &triangles).unwrap();
             let after = distortion(&points, &positions, &triangles).unwrap();
             assert_eq!(folded_triangles(&points, &triangles), 0, "arm {arm}");
@@ -1103,7 +1087,11 @@ mod tests {
         let up = nalgebra::Rotation3::rotation_between(&points[ends[0]], &Vector3::z()).unwrap();
         points.iter_mut().for_each(|p| *p = up * *p);
         assert!(points[ends[0]].z > 0.999);
-        seam_through_squeezed(&mut points, &positions, &triangles);
+        seam_through_squeezed(
+            &mut points,
+            &triangles,
+            &vertex_areas(&positions, &triangles),
+        );
         for v in ends {
             assert!(points[v].z.abs() < 0.1, "{:?}", points[v]);
         }
