@@ -160,7 +160,7 @@ pub fn default_settings(genus: u32, vertices: usize) -> (SplineSettings, FitSett
         ..SplineSettings::default()
     };
     let fit = FitSettings {
-        surface_smoothness: surface_smoothness(genus),
+        surface_smoothness: true,
         raise_smoothness: true,
         edge_samples: MESH_EDGE_SAMPLES,
         ..FitSettings::for_grid(grid)
@@ -168,10 +168,15 @@ pub fn default_settings(genus: u32, vertices: usize) -> (SplineSettings, FitSett
     (spline, fit)
 }
 
-/// Whether a user's genus-`genus` mesh is fitted with the smoothness term in the surface's arc
-/// length ([`FitSettings::surface_smoothness`]): from genus 1, where the map onto the polygon
-/// stretches a tube or a thin handle one way. Measured with `ntori fit` (plain term → arc length;
-/// two-sided Hausdorff, largest |κ| against the mesh's, normals at the 90th percentile):
+/// Whether a user's genus-`genus` mesh, mapped with `map`'s distortion, is fitted with the
+/// smoothness term in the surface's arc length ([`FitSettings::surface_smoothness`], which
+/// [`default_settings`] asks for): at every genus, unless a genus-0 map onto the sphere still
+/// squeezes a limb by more than [`MAX_SQUEEZE_FOR_ARC_LENGTH`] in area, where a first fit's
+/// metric is no guide. Where the map stretches the surface one way (a tube or a thin handle onto
+/// the polygon, a limb onto the sphere) the grids' term charges bending along the squeezed
+/// direction far more than across it, and leaves ripples round the tube free. Measured with
+/// `ntori fit` (grids' term → arc length; two-sided Hausdorff, largest |κ| against the mesh's,
+/// normals at the 90th percentile):
 ///
 /// | mesh | vertices | Hausdorff | \|κ\| / mesh's | normals (90%) |
 /// |---|---|---|---|---|
@@ -181,17 +186,27 @@ pub fn default_settings(genus: u32, vertices: usize) -> (SplineSettings, FitSett
 /// | `plate-genus-3.obj` | 1 581 | 0.89% → 0.89% | 3.56× → 1.28× | 4.30° → 4.08° |
 /// | `rounded-block-genus-2.obj` | 1 182 | 0.67% → 0.65% | 3.28× → 2.97× | 6.30° → 6.07° |
 /// | CGAL `3torus-smooth.off` (genus 3) | 571 | 6.0% → 4.6% | 509× → 9.9× | 9.0° → 4.8° |
+/// | Stanford bunny (genus 0, ×20) | 28 088 | 0.76% → 0.49% | 2.63× → 3.07× | 8.6° → 5.2° |
+/// | pymeshlab's airplane (genus 0, ×21) | 5 400 | 0.79% → 0.73% | 24.0× → 4.37× | 6.85° → 5.76° |
+/// | pymeshlab's bone (genus 0, ×4.7) | 1 513 | 1.82% → 1.74% | 33.4× → 3.05× | 8.37° → 4.11° |
+/// | `dumbbell-genus-0.obj` (×1.04) | 642 | 0.210% → 0.208% | 3.11× → 3.92× | 0.83° → 0.80° |
 ///
-/// Genus 0 keeps the grids' term: its map squeezes long limbs by up to ×1 000 in area, where a
-/// first fit's metric is no guide (pymeshlab's airplane went from 4.9% to 18.7% apart, 2 140 to
-/// 5 500 crossing pairs; the cow from 16% to 503%, the cactus from 35% to 89 times the diagonal).
-/// Taken only where the sphere's map is even (area factors up to ×100) it was no clear gain
-/// either: the dumbbell's |κ| went from 3.27× to 1.71× its mesh's, but its distance from 0.211%
-/// to 0.273% and its normals from 1.05° to 1.15°; the bone (×14) came closer (2.0% → 1.6%) but
-/// its patches apart from 0.60% to 1.07% and Gauss–Bonnet from 1.9e-2 to 3.5e-2.
-pub fn surface_smoothness(genus: u32) -> bool {
-    genus >= 1
+/// (Genus 0's factor is its map's largest area factor.) The bone's ripples along its shaft, plain
+/// in a mean-curvature rendering, went; its largest residual rose from 0.72% to 1.53% of the
+/// diagonal, at the notch between the knobs at its ends, which the stronger λ it now passes its
+/// curvature check with bridges.
+pub fn surface_smoothness(genus: u32, map: Option<Distortion>) -> bool {
+    genus >= 1 || map.is_some_and(|d| d.area_max <= MAX_SQUEEZE_FOR_ARC_LENGTH)
 }
+
+/// The largest area factor of a genus-0 mesh's map onto the sphere ([`Distortion::area_max`]) at
+/// which its fit measures smoothness in arc length ([`surface_smoothness`]). Beyond it a limb's
+/// patch is squeezed into a few control cells and a first fit's metric there is no guide:
+/// pymeshlab's airplane mapped without the sphere's equalizing flow (×1 223) went from 3 failed
+/// checks to 5 with it (patches 0.53% → 1.29% apart, 0 → 12 crossing triangle pairs); before the
+/// flow and the seam through the squeezed parts it had gone from 4.9% to 18.7% of the diagonal,
+/// and the cow (×2·10⁸ at its tail's tip) from 16% to 503%.
+pub const MAX_SQUEEZE_FOR_ARC_LENGTH: f64 = 100.0;
 
 /// A model fitted to a user's mesh, and how well it fits.
 #[derive(Clone, Debug)]
@@ -382,6 +397,11 @@ fn finish(
         ..
     } = *input;
     progress(FitStage::Fitting);
+    let fit_settings = FitSettings {
+        surface_smoothness: fit_settings.surface_smoothness
+            && surface_smoothness(genus, mapped.distortion),
+        ..fit_settings
+    };
     let points = mapped.points;
     let diagonal = diagonal(positions);
     let (surface, smoothness, integrals) =
@@ -1765,6 +1785,30 @@ fn equivariant_lifts(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    fn squeezed(area_max: f64) -> Option<Distortion> {
+        Some(Distortion {
+            angle_mean: 2.0,
+            angle_max: 10.0,
+            area_mean: 1.5,
+            area_max,
+        })
+    }
+
+    /// Every genus from 1 takes the arc-length term whatever its map; genus 0 only where its map
+    /// onto the sphere is measured and squeezes nothing more than ×100.
+    #[test]
+    fn arc_length_smoothness_waits_for_an_even_sphere_map() {
+        for genus in 1..=64 {
+            assert!(surface_smoothness(genus, None));
+            assert!(surface_smoothness(genus, squeezed(1e9)));
+        }
+        assert!(surface_smoothness(0, squeezed(20.0)));
+        assert!(surface_smoothness(0, squeezed(MAX_SQUEEZE_FOR_ARC_LENGTH)));
+        assert!(!surface_smoothness(0, squeezed(140.0)));
+        assert!(!surface_smoothness(0, squeezed(2e8)));
+        assert!(!surface_smoothness(0, None));
+    }
 
     /// A map that does not settle says the marking was poor where the screen scored it so, and
     /// only then; other errors pass through as they are.

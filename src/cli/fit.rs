@@ -165,7 +165,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         embedding::mesh_fit::MESH_EDGE_SAMPLES
     });
-    fit.surface_smoothness = embedding::mesh_fit::surface_smoothness(valid.genus);
+    // In arc length where the map allows (`mesh_fit::surface_smoothness`, decided once mapped).
+    fit.surface_smoothness = true;
     // λ is raised where the default leaves the surface rough, not where the user chose it.
     fit.raise_smoothness = args.spline.smoothness.is_none();
     let progress = FitProgress::new(args.quiet);

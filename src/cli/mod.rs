@@ -123,7 +123,7 @@ struct FitArgs {
           value_parser = clap::value_parser!(u64).range(1..=4))]
     continuity: u64,
     /// Weight λ of the control grids' smoothness energy in the fit (relative to the data term;
-    /// `fit` from genus 1 measures that energy in the surface's arc length, from a first fit)
+    /// `fit` measures that energy in the surface's arc length, from a first fit)
     /// [default: 1e-4 for grids up to 32, 2e-3 for finer ones, whose second differences are
     /// smaller for the same shape, and 1e-2 for new's plates of genus 2 to 40 on those (3e-2 at genus
     /// 27 to 32); `fit` raises
