@@ -773,7 +773,7 @@ impl NewReport {
     fn solve_text(&self) -> String {
         match self.newton {
             None => {
-                let mut text = count(self.sweeps, "relaxation sweep", "relaxation sweeps");
+                let text = count(self.sweeps, "relaxation sweep", "relaxation sweeps");
                 let later = [
                     (self.planar_rounds, "planar round", "planar rounds"),
                     (
@@ -787,10 +787,12 @@ impl NewReport {
                     .filter(|&(n, _, _)| n > 0)
                     .map(|(n, one, many)| count(n, one, many))
                     .collect();
-                if !later.is_empty() {
-                    text = format!("{text}, then {}", later.join(" and "));
+                // A genus-0 map evened out in the plane runs no sweeps.
+                match (self.sweeps, later.is_empty()) {
+                    (0, false) => later.join(" and "),
+                    (_, false) => format!("{text}, then {}", later.join(" and ")),
+                    (_, true) => text,
                 }
-                text
             }
             Some(n) => format!(
                 "{} and {} ({}, residual {:.0e}){}",
