@@ -282,6 +282,9 @@ pub struct ShapeReport {
     /// to, checked against `MIN_CREASE_ROUNDING`; `None` where no point is near one.
     pub sharp_edges: usize,
     pub crease_rounding: Option<f64>,
+    /// Whether any point measured lies away from the sharp edges: on a coarse polygon mesh every
+    /// edge may be sharp, and then the largest |κ| above is 0 and only the rounding is checked.
+    pub away_from_creases: bool,
     /// The angle between the surface's normal and the reference normal at the input mesh's
     /// vertices, in degrees: median and 90th percentile.
     pub normal_deviation_median: f64,
@@ -414,6 +417,7 @@ fn measure_shape(
         curvature_from,
         sharp_edges: sharp.len(),
         crease_rounding: curvature.rounding(diagonal),
+        away_from_creases: curvature.away.at.is_some(),
         normal_deviation_median: normals.median,
         normal_deviation_p90: normals.p90,
         normals_from,
@@ -748,13 +752,25 @@ impl NewReport {
         })
     }
 
-    /// Where the input has sharp edges, how the curvature check treats them, in words (else
-    /// nothing).
-    fn crease_text(&self) -> String {
+    /// The curvature check's numbers, in words: the largest |κ| against the input's, away from
+    /// the input's sharp edges where it has them, and how tightly those are rounded.
+    fn curvature_text(&self) -> String {
         let shape = &self.shape;
+        let input = match shape.curvature_from {
+            NormalReference::Intended => "intended shape's",
+            NormalReference::Mesh => "input's",
+        };
+        let largest = format!(
+            "largest |κ| {:.2}, {:.2}× the {input} {:.2}",
+            shape.max_principal_curvature,
+            shape.curvature_ratio,
+            shape.input_max_principal_curvature
+        );
         if shape.sharp_edges == 0 {
-            return String::new();
+            return largest;
         }
+        let edges = count(shape.sharp_edges, "sharp mesh edge", "sharp mesh edges");
+        let band = 100.0 * embedding::quality::CREASE_BAND;
         let rounding = shape.crease_rounding.map_or(String::new(), |r| {
             format!(
                 "; rounds them to a radius of {:.2}% of the diagonal (at least {}%)",
@@ -762,11 +778,13 @@ impl NewReport {
                 100.0 * embedding::quality::MIN_CREASE_ROUNDING
             )
         });
-        format!(
-            " away from its {} (within {}% of the diagonal){rounding}",
-            count(shape.sharp_edges, "sharp mesh edge", "sharp mesh edges"),
-            100.0 * embedding::quality::CREASE_BAND
-        )
+        if shape.away_from_creases {
+            format!("{largest} away from its {edges} (within {band}% of the diagonal){rounding}")
+        } else {
+            format!(
+                "every point lies within {band}% of the diagonal of the input's {edges}{rounding}"
+            )
+        }
     }
 
     /// How the map was solved, in words.
@@ -845,7 +863,7 @@ impl NewReport {
              (Hausdorff, t_e = t_r = {dist_t})\n\
              Gauss–Bonnet: ∫K dA = {k:.6}, 2π(2 − 2n) = {e:.6}, off by {gb:.1e} of {gb_of} ({gbv})\n\
              patches: disagree by up to {pd:.3}% of the diagonal (rms {pdr:.3}%) ({pdv})\n\
-             curvature: largest |κ| {kmax:.2}, {ratio:.2}× the {kfrom} {kin:.2}{creases} ({kv})\n\
+             curvature: {curvature} ({kv})\n\
              normals: {nmed:.2}° from the {reference} (90%: {n90:.2}°) ({nv})\n\
              {flat}self-intersections: {crossings} crossing triangle pairs at t_e = t_r = {t} ({ev}){coarse}\n\
              area {area:.4}, {secs:.2} s\n",
@@ -878,15 +896,8 @@ impl NewReport {
             pd = 100.0 * self.shape.patch_disagreement,
             pdr = 100.0 * self.shape.patch_disagreement_rms,
             pdv = verdict(self.shape_verdict.disagreement),
-            kmax = self.shape.max_principal_curvature,
-            ratio = self.shape.curvature_ratio,
-            kin = self.shape.input_max_principal_curvature,
-            kfrom = match self.shape.curvature_from {
-                NormalReference::Intended => "intended shape's",
-                NormalReference::Mesh => "input's",
-            },
+            curvature = self.curvature_text(),
             kv = verdict(self.shape_verdict.curvature),
-            creases = self.crease_text(),
             nmed = self.shape.normal_deviation_median,
             reference = match self.shape.normals_from {
                 NormalReference::Intended => "intended shape's",

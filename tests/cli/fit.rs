@@ -655,6 +655,54 @@ fn a_cube_is_fitted_with_its_edges_rounded_and_written() {
     );
 }
 
+/// A rod 50 times longer than thick, of six vertices: every point of it lies within
+/// `CREASE_BAND` of one of its sharp edges, so there is no |κ| away from them to report, and the
+/// curvature line says so rather than "largest |κ| 0.00, 0.00× the input's" (as CGAL's coarse
+/// polygonal `double-torus-example.off` read). The rod itself does not fit (the sphere's map
+/// squeezes it ×750 on average), and nothing is written.
+#[test]
+fn a_mesh_that_is_all_sharp_edges_says_so_in_its_curvature_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, path) = (dir.path().join("rod.obj"), dir.path().join("rod.json"));
+    let corners: Vec<[f32; 3]> = [0.0f32, 1.0]
+        .iter()
+        .flat_map(|&z| {
+            (0..3).map(move |k| {
+                let a = 2.0 * std::f32::consts::PI * k as f32 / 3.0;
+                [0.02 * a.cos(), 0.02 * a.sin(), z]
+            })
+        })
+        .collect();
+    let mut faces = vec![vec![0, 2, 1], vec![3, 4, 5]];
+    for k in 0..3 {
+        let (a, b) = (k, (k + 1) % 3);
+        faces.extend([vec![a, b, b + 3], vec![a, b + 3, a + 3]]);
+    }
+    write_obj(&mesh, &corners, &faces);
+    let output = ntori()
+        .arg("fit")
+        .arg(&mesh)
+        .args(["--up", "z", "-q", "-o"])
+        .arg(&path)
+        .assert()
+        .failure()
+        .get_output()
+        .stdout
+        .clone();
+    let text = String::from_utf8(output).unwrap();
+    let line = text.lines().find(|l| l.starts_with("curvature:")).unwrap();
+    assert!(
+        line.starts_with("curvature: every point lies within 3% of the diagonal of the input's "),
+        "{line}"
+    );
+    assert!(
+        line.contains("sharp mesh edges; rounds them to a radius of"),
+        "{line}"
+    );
+    assert!(!line.contains("largest |κ|"), "{line}");
+    assert!(!path.exists());
+}
+
 /// A model exported to GLB (metres, +y up) and fitted again keeps its size and orientation: the
 /// second export's bounding box is the first's. Read as the file's numbers stand (the old
 /// import), the model came back 100 times smaller and standing on its edge.
