@@ -853,16 +853,43 @@ fn relax(
             }
         }
         centre(points, areas);
-        let moved = points
-            .iter()
-            .zip(&before)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
-        if moved < tolerance {
+        if moved_beyond_rotation(&before, points) < tolerance {
             return sweep + 1;
         }
     }
     sweeps
+}
+
+/// The largest distance a point moved from `before` to `after`, once the rotation that best
+/// carries the one onto the other is taken out (Kabsch: the SVD of Σ after·beforeᵀ, reflections
+/// excluded). The sweeps turn the whole map slowly as they go, a rotation that changes nothing of
+/// its shape: measured with it, the capsule's map (trimesh's, 2 306 vertices) kept moving by
+/// 1.4e-5 a sweep for its whole 5 000 sweeps a round, 20 000 in all; without it, it settles to
+/// 1e-8 in 9 829 (the fit 14 s → 7.7 s, its distance from the mesh 0.049% → 0.060% of the
+/// diagonal: the caps' grids turned about the poles), and CGAL's `part.off` in 2 046 of 20 000.
+fn moved_beyond_rotation(before: &[Vector3<f64>], after: &[Vector3<f64>]) -> f64 {
+    let covariance = after
+        .iter()
+        .zip(before)
+        .fold(nalgebra::Matrix3::zeros(), |sum, (a, b)| {
+            sum + a * b.transpose()
+        });
+    let svd = covariance.svd(true, true);
+    let rotation = match (svd.u, svd.v_t) {
+        (Some(u), Some(v_t)) => {
+            let mut sign = nalgebra::Matrix3::identity();
+            if (u * v_t).determinant() < 0.0 {
+                sign[(2, 2)] = -1.0;
+            }
+            u * sign * v_t
+        }
+        _ => nalgebra::Matrix3::identity(),
+    };
+    after
+        .iter()
+        .zip(before)
+        .map(|(a, b)| (a - rotation * b).norm())
+        .fold(0.0, f64::max)
 }
 
 /// y seen from x's frame: stereographic projection from −x onto the tangent plane at x (a tangent
@@ -1044,6 +1071,23 @@ mod tests {
                 after.area_mean <= 0.75 * before.area_mean,
                 "arm {arm}: {before:?} → {after:?}"
             );
+        }
+    }
+
+    /// A turned copy of a map has not moved; one point pushed off has moved by as much, whichever
+    /// way the copy is turned.
+    #[test]
+    fn motion_leaves_out_the_rotation() {
+        let (_, points, _) = ellipsoid(1.0);
+        for (axis, angle) in [(Vector3::z(), 0.3), (Vector3::new(1.0, 2.0, -0.5), 2.9)] {
+            let turn =
+                nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), angle);
+            let mut after: Vec<_> = points.iter().map(|p| turn * p).collect();
+            assert!(moved_beyond_rotation(&points, &after) < 1e-12);
+            let push = 1e-3 * Vector3::new(0.3, -0.4, 0.5).normalize();
+            after[7] += push;
+            let moved = moved_beyond_rotation(&points, &after);
+            assert!((moved - 1e-3).abs() < 1e-4, "{moved}");
         }
     }
 
