@@ -41,7 +41,7 @@ use crate::harmonic::Convergence;
 use crate::integrals::SurfaceIntegrals;
 use crate::marking::Measure;
 use crate::quality;
-use crate::sphere_map::{EXTRA_ROUNDS, sphere_map};
+use crate::sphere_map::{EXTRA_ROUNDS, Relaxation, sphere_map};
 use crate::spline_surface::Surface;
 use crate::surface::{Layout, Point3, SplineSettings, Vector3};
 
@@ -745,14 +745,12 @@ fn map_to_sphere(
         round: 1,
         rounds: fit_settings.stretch_rounds + EXTRA_ROUNDS + 1,
     });
-    let map = sphere_map(
-        positions,
-        triangles,
-        areas,
-        fit_settings.sweeps,
-        fit_settings.stretch_rounds,
-        RELAX_TOLERANCE,
-    )?;
+    let relaxation = Relaxation {
+        sweeps: fit_settings.sweeps,
+        stretch_rounds: fit_settings.stretch_rounds,
+        tolerance: RELAX_TOLERANCE,
+    };
+    let map = sphere_map(positions, triangles, areas, relaxation)?;
     let sphere: Vec<Point3> = map.points.iter().map(|&v| Point3::from(v)).collect();
     let edges = if fit_settings.edge_samples > 0.0 {
         sphere_edge_midpoints(atlas, &sphere, triangles)

@@ -82,15 +82,23 @@ pub(crate) struct SphereMap {
 /// within 1% with three).
 pub(crate) const EXTRA_ROUNDS: usize = 2;
 
-/// The map, with `stretch_rounds` + [`EXTRA_ROUNDS`] rounds of reweighting after the first
-/// re-punctured solve. `areas` are the mesh's vertex areas (the mass that is centred).
+/// How a map is relaxed on the sphere where it is ([`swept`]): at most `sweeps` sweeps a round,
+/// each round ending once no vertex moves by `tolerance` in a sweep, over `stretch_rounds` +
+/// [`EXTRA_ROUNDS`] rounds of stretch reweighting after the first.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Relaxation {
+    pub sweeps: usize,
+    pub stretch_rounds: usize,
+    pub tolerance: f64,
+}
+
+/// The map of a genus-0 mesh onto the sphere, evened out in the plane or relaxed there with
+/// `relaxation`. `areas` are the mesh's vertex areas (the mass that is centred).
 pub(crate) fn sphere_map(
     positions: &[Point3],
     triangles: &[[u32; 3]],
     areas: &[f64],
-    sweeps: usize,
-    stretch_rounds: usize,
-    tolerance: f64,
+    relaxation: Relaxation,
 ) -> Result<SphereMap, EmbeddingError> {
     let weights = floater::mean_value_weights(positions, triangles)?;
     let removed = largest_triangle(positions, triangles)?;
@@ -131,16 +139,7 @@ pub(crate) fn sphere_map(
     let (mut points, neighbours, folded, used) = if evened > 0 {
         (evened_out, evened_weights, 0, 0)
     } else {
-        swept(
-            points,
-            &weights,
-            positions,
-            triangles,
-            areas,
-            sweeps,
-            stretch_rounds,
-            tolerance,
-        )
+        swept(points, &weights, positions, triangles, areas, relaxation)
     };
     let mut distortion = distortion(&points, positions, triangles);
     // Conformal or evened out, a long limb stays squeezed (the bunny's ears ×260 in area): the
@@ -166,21 +165,23 @@ pub(crate) fn sphere_map(
     })
 }
 
-/// The map relaxed on the sphere: `stretch_rounds` + [`EXTRA_ROUNDS`] rounds of mean value
-/// sweeps, the weights divided by the map's stretch from the second round on, each round kept
-/// only if it folds no more triangles than the map it started from. Returns the map, the weights
-/// it was last solved with, its folded triangles and the sweeps run.
-#[allow(clippy::too_many_arguments)]
+/// The map relaxed on the sphere: rounds of mean value sweeps ([`Relaxation`]), the weights
+/// divided by the map's stretch from the second round on, each round kept only if it folds no
+/// more triangles than the map it started from. Returns the map, the weights it was last solved
+/// with, its folded triangles and the sweeps run.
 fn swept(
     mut points: Vec<Vector3<f64>>,
     weights: &[Vec<(u32, f64)>],
     positions: &[Point3],
     triangles: &[[u32; 3]],
     areas: &[f64],
-    sweeps: usize,
-    stretch_rounds: usize,
-    tolerance: f64,
+    relaxation: Relaxation,
 ) -> (Vec<Vector3<f64>>, Neighbours, usize, usize) {
+    let Relaxation {
+        sweeps,
+        stretch_rounds,
+        tolerance,
+    } = relaxation;
     let mut neighbours: Neighbours = weights
         .iter()
         .map(|list| list.iter().map(|&(u, w)| (w, u)).collect())
