@@ -97,6 +97,9 @@ pub struct Distortion {
     /// largest.
     pub area_mean: f64,
     pub area_max: f64,
+    /// The triangle whose area factor is `area_max`: an index into the triangles measured (the
+    /// cut disk's, or a user's mesh's), to say where a map squeezes most.
+    pub area_max_triangle: usize,
 }
 
 impl Parameterization {
@@ -130,7 +133,8 @@ impl Distortion {
         }
         let ratio = total2 / total3;
         let (mut angle_sum, mut angle_max, mut log_sum, mut log_max) = (0.0, 1.0f64, 0.0, 0.0f64);
-        for &(area, angle, jac) in triangles {
+        let mut area_max_triangle = 0;
+        for (t, &(area, angle, jac)) in triangles.iter().enumerate() {
             let log = (jac / ratio).abs().ln().abs();
             let angle = if angle.is_finite() {
                 angle
@@ -140,13 +144,16 @@ impl Distortion {
             angle_sum += area * angle;
             angle_max = angle_max.max(angle);
             log_sum += area * log;
-            log_max = log_max.max(log);
+            if log > log_max {
+                (log_max, area_max_triangle) = (log, t);
+            }
         }
         Some(Distortion {
             angle_mean: angle_sum / total3,
             angle_max,
             area_mean: (log_sum / total3).exp(),
             area_max: log_max.exp(),
+            area_max_triangle,
         })
     }
 }

@@ -1790,6 +1790,7 @@ mod tests {
             angle_max: 10.0,
             area_mean: 1.5,
             area_max,
+            area_max_triangle: 0,
         })
     }
 

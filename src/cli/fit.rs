@@ -196,6 +196,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     .with_context(|| format!("cannot fit {}", args.mesh.display()))?;
     let fitted = &user.fit;
     let (positions, triangles) = user.mesh(&valid.positions, &valid.triangles);
+    let squeeze = SqueezeReport::of(fitted, positions, triangles, placement);
     let mut checked = as_fitted(fitted, positions, triangles, settings, fit.agreement);
     checked.intended_normals = cage.as_ref().map(|c| &c.normals[..]);
     let report = check(&checked, start, &|s| progress.stage(s))?;
@@ -236,6 +237,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         },
         smoothness: fitted.smoothness.clone(),
         loops: LoopsReport::of(fitted),
+        squeeze,
         fit: report,
         output: &args.output,
         written,
@@ -329,11 +331,58 @@ struct FitReport<'a> {
     evening: Option<EveningReport>,
     /// The smoothness weight asked for and used, and each one tried where it was raised.
     smoothness: SmoothnessReport,
+    /// Where a genus-0 map onto the sphere still squeezes a limb (none where it is even enough).
+    squeeze: Option<SqueezeReport>,
     fit: NewReport,
     #[serde(skip)]
     output: &'a Path,
     #[serde(skip)]
     written: bool,
+}
+
+/// Where a genus-0 mesh's map onto the sphere distorts area most, where that is more than
+/// `mesh_fit::MAX_SQUEEZE_FOR_ARC_LENGTH`: a limb or a tail many times longer than thick, which the
+/// sphere's map squeezes and the fit follows poorly (the cow's tail, ×2·10⁸ at its tip).
+#[derive(Serialize)]
+struct SqueezeReport {
+    /// The largest area factor ([`embedding::fit::Distortion::area_max`]).
+    factor: f64,
+    /// The middle of the triangle it is at, in the file's coordinates.
+    at: [f64; 3],
+}
+
+impl SqueezeReport {
+    fn of(
+        fitted: &embedding::mesh_fit::MeshFit,
+        positions: &[embedding::Point3],
+        triangles: &[[u32; 3]],
+        placement: import::Placement,
+    ) -> Option<SqueezeReport> {
+        let map = fitted.parameterization.map_distortion?;
+        if fitted.genus != 0 || map.area_max <= embedding::mesh_fit::MAX_SQUEEZE_FOR_ARC_LENGTH {
+            return None;
+        }
+        let corners = triangles.get(map.area_max_triangle)?;
+        let middle = corners
+            .iter()
+            .map(|&v| positions[v as usize].coords)
+            .sum::<embedding::Vector3>()
+            / 3.0;
+        let at = placement.up.apply(middle / placement.factor);
+        Some(SqueezeReport {
+            factor: map.area_max,
+            at: [at.x, at.y, at.z],
+        })
+    }
+
+    fn to_text(&self) -> String {
+        format!(
+            "squeezed: the sphere's map still distorts area ×{:.2e} near ({:.4}, {:.4}, {:.4}) in \
+             the file: a limb or tail many times longer than thick, which the fit follows poorly \
+             there\n",
+            self.factor, self.at[0], self.at[1], self.at[2]
+        )
+    }
 }
 
 /// What reading the mesh changed.
@@ -518,10 +567,15 @@ impl Report for FitReport<'_> {
             )
         });
         let smoothness = smoothness_text(&self.smoothness);
+        let squeeze = self
+            .squeeze
+            .as_ref()
+            .map_or(String::new(), SqueezeReport::to_text);
         format!(
             "read {}{notes}\n{cage}{split}{loops}\n{evening}{smoothness}",
             i.path
         ) + &self.fit.to_text()
+            + &squeeze
             + &outcome
     }
 }

@@ -178,8 +178,8 @@ fn fit_maps_a_genus_zero_mesh_onto_the_sphere() {
     // The neck's profile, 0.45 + 0.55|x|^1.5, has no bounded curvature, and with the edges'
     // middles as data the surface follows it: its peak lies between the t = 16 points where the
     // smoothness ladder first looked, which passed λ = 0.05 while the final check read 5.6× the
-    // mesh's |κ| and failed. The ladder also takes the quadrature's peak now, raises λ to 1 and
-    // the fit passes (measured 3.07×).
+    // mesh's |κ| and failed. The ladder also takes the quadrature's peak now and raises λ (to 1
+    // with the grids' smoothness term, 3.07×; to 0.05 in arc length, 3.92×), and the fit passes.
     let smoothness = &report["smoothness"];
     assert!(
         smoothness["used"].as_f64() > smoothness["asked"].as_f64(),
@@ -201,6 +201,8 @@ fn fit_maps_a_genus_zero_mesh_onto_the_sphere() {
         distortion["angle_mean"].as_f64().unwrap() < 3.0,
         "{distortion}"
     );
+    // Nothing is squeezed, so nothing is said about it.
+    assert!(report["squeeze"].is_null(), "{}", report["squeeze"]);
     // Between the vertices too (two-sided Hausdorff): measured 0.21% of the diagonal (0.92% when
     // this test was written), within issue 14's 0.5%.
     let distance = report["fit"]["shape"]["distance_to_input"]
@@ -701,6 +703,21 @@ fn a_mesh_that_is_all_sharp_edges_says_so_in_its_curvature_line() {
     );
     assert!(!line.contains("largest |κ|"), "{line}");
     assert!(!path.exists());
+    // The map squeezes the rod (×10⁷ at worst, measured), and the report says where, in the
+    // file's coordinates: on the rod.
+    let squeezed = text.lines().find(|l| l.starts_with("squeezed:")).unwrap();
+    let numbers: Vec<f64> = squeezed
+        .split(|c: char| !(c.is_ascii_digit() || "-.e".contains(c)))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let [factor, x, y, z] = numbers[..4] else {
+        panic!("{squeezed}")
+    };
+    assert!(factor > 100.0, "{squeezed}");
+    assert!(
+        x.abs() <= 0.02 && y.abs() <= 0.02 && (0.0..=1.0).contains(&z),
+        "{squeezed}"
+    );
 }
 
 /// A model exported to GLB (metres, +y up) and fitted again keeps its size and orientation: the
