@@ -59,6 +59,15 @@ use faer::sparse::{SparseColMat, Triplet};
 /// Each vertex's neighbours with their weights, (weight, neighbour), as the sweeps take them.
 type Neighbours = Vec<Vec<(f64, u32)>>;
 
+/// `weights` ((neighbour, weight) per vertex, as [`floater::mean_value_weights`] gives them) in
+/// the sweeps' order.
+fn neighbours_of(weights: &[Vec<(u32, f64)>]) -> Neighbours {
+    weights
+        .iter()
+        .map(|list| list.iter().map(|&(u, w)| (w, u)).collect())
+        .collect()
+}
+
 /// Every vertex of a genus-0 mesh on the unit sphere.
 #[derive(Clone, Debug)]
 pub(crate) struct SphereMap {
@@ -182,10 +191,7 @@ fn swept(
         stretch_rounds,
         tolerance,
     } = relaxation;
-    let mut neighbours: Neighbours = weights
-        .iter()
-        .map(|list| list.iter().map(|&(u, w)| (w, u)).collect())
-        .collect();
+    let mut neighbours = neighbours_of(weights);
     let mut folded = folded_triangles(&points, triangles);
     let mut used = 0;
     for round in 0..=stretch_rounds + EXTRA_ROUNDS {
@@ -532,10 +538,7 @@ fn even_out(
     let area_mean = |points: &[Vector3<f64>]| {
         distortion(points, positions, triangles).map_or(f64::INFINITY, |d| d.area_mean)
     };
-    let neighbours: Vec<Vec<(f64, u32)>> = weights
-        .iter()
-        .map(|list| list.iter().map(|&(u, w)| (w, u)).collect())
-        .collect();
+    let neighbours = neighbours_of(weights);
     let mut weights = weights.to_vec();
     // One puncture for every round: moved from round to round, the pins jolt the map and the
     // rounds do not settle (the animal's mean went ×55 → 11 → 6.6 → 5.4 → 2.8 → 4.8).
@@ -565,10 +568,7 @@ fn even_out(
         }
         (*points, taken) = (trial.clone(), round + 1);
         (current, mean) = (trial, trial_mean);
-        taken_weights = weights
-            .iter()
-            .map(|list| list.iter().map(|&(u, w)| (w, u)).collect())
-            .collect();
+        taken_weights = neighbours_of(&weights);
     }
     Ok((taken, taken_weights))
 }
@@ -1109,10 +1109,7 @@ mod tests {
                 map: start,
             } = conformal_map(&positions, &triangles);
             assert_eq!(folded_triangles(&start, &triangles), 0, "arm {arm}");
-            let neighbours: Vec<Vec<(f64, u32)>> = weights
-                .iter()
-                .map(|list| list.iter().map(|&(u, w)| (w, u)).collect())
-                .collect();
+            let neighbours = neighbours_of(&weights);
             let mut points = start.clone();
             let round = equalize_areas(&mut points, &neighbours, &positions, &triangles, &areas);
             let before = distortion(&start, &positions, &triangles).unwrap();
