@@ -95,6 +95,7 @@ fn report(name: &str, positions: &[Point3], triangles: &[[u32; 3]]) {
         smoothness: env("SMOOTHNESS").unwrap_or(embedding::fit::default_smoothness(grid)),
         raise_smoothness: env("SMOOTHNESS").is_none(),
         agreement: env("AGREEMENT").unwrap_or(fit_defaults.agreement),
+        raise_agreement: env("AGREEMENT").is_none(),
         edge_samples: env("EDGE_SAMPLES").unwrap_or(fit_defaults.edge_samples),
         ..fit_defaults
     };

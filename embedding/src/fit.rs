@@ -276,6 +276,10 @@ pub struct FitSettings {
     /// smoothness (a user's mesh: [`crate::mesh_fit`]'s `smooth_enough`); off where the user
     /// chose λ.
     pub raise_smoothness: bool,
+    /// Where the fitted surface passes those checks but crosses itself, fit again with the
+    /// agreement rows raised ([`crate::mesh_fit::RAISED_AGREEMENTS`]); off where the user chose
+    /// the agreement weight.
+    pub raise_agreement: bool,
     /// Weight of the agreement rows (0: none): where two charts' blends overlap, their own
     /// patches are also made to agree with each other at a lattice of points between the data
     /// ([`AGREEMENT_STEP`]), not only each with the data at the data's points (the patch terms).
@@ -306,6 +310,7 @@ impl Default for FitSettings {
             surface_smoothness: false,
             metric_coarsening: 1,
             raise_smoothness: false,
+            raise_agreement: false,
             agreement: 0.0,
             edge_samples: 0.0,
         }

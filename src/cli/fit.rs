@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 use embedding::fit::FitStage;
 use embedding::mesh_fit::{
-    LONG_EDGE_FACTOR, MeshFit, SPLIT_ALWAYS_FROM, SPLIT_FROM, SmoothnessReport, UserMeshFit,
-    fit_user_mesh, mesh_fit_disk_grid, mesh_fit_grid, mesh_model,
+    AgreementReport, LONG_EDGE_FACTOR, MeshFit, SPLIT_ALWAYS_FROM, SPLIT_FROM, SmoothnessReport,
+    UserMeshFit, fit_user_mesh, mesh_fit_disk_grid, mesh_fit_grid, mesh_model,
 };
 use ntori::io::import::{self, ValidMesh, cage};
 use serde::Serialize;
@@ -169,6 +169,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     fit.surface_smoothness = true;
     // λ is raised where the default leaves the surface rough, not where the user chose it.
     fit.raise_smoothness = args.spline.smoothness.is_none();
+    // And the agreement rows where the surface crosses itself, unless the user chose them.
+    fit.raise_agreement = args.spline.agreement.is_none();
     let progress = FitProgress::new(args.quiet);
     let fit_stage = |s: FitStage| progress.fit_stage(s);
     let user = match cage {
@@ -197,7 +199,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let fitted = &user.fit;
     let (positions, triangles) = user.mesh(&valid.positions, &valid.triangles);
     let squeeze = SqueezeReport::of(fitted, positions, triangles, placement);
-    let mut checked = as_fitted(fitted, positions, triangles, settings, fit.agreement);
+    let mut checked = as_fitted(fitted, positions, triangles, settings);
     checked.intended_normals = cage.as_ref().map(|c| &c.normals[..]);
     let report = check(&checked, start, &|s| progress.stage(s))?;
     progress.finish();
@@ -236,6 +238,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             split_failed: user.split_failed.clone(),
         },
         smoothness: fitted.smoothness.clone(),
+        agreement: fitted.agreement.clone(),
         loops: LoopsReport::of(fitted),
         squeeze,
         fit: report,
@@ -300,7 +303,6 @@ fn as_fitted<'a>(
     positions: &'a [embedding::Point3],
     triangles: &'a [[u32; 3]],
     settings: embedding::SplineSettings,
-    agreement: f64,
 ) -> Fitted<'a> {
     Fitted {
         surface: &fit.surface,
@@ -316,9 +318,10 @@ fn as_fitted<'a>(
         mesh_diagonal: fit.mesh_diagonal,
         settings,
         smoothness: fit.smoothness.used,
-        agreement,
+        agreement: fit.agreement.used,
         edge_samples: fit.edge_samples,
         integrals: fit.integrals.as_ref(),
+        crossings: fit.crossings.as_deref(),
     }
 }
 
@@ -331,6 +334,9 @@ struct FitReport<'a> {
     evening: Option<EveningReport>,
     /// The smoothness weight asked for and used, and each one tried where it was raised.
     smoothness: SmoothnessReport,
+    /// The agreement weight asked for and used, and each one tried where the surface crossed
+    /// itself.
+    agreement: AgreementReport,
     /// Where a genus-0 map onto the sphere still squeezes a limb (none where it is even enough).
     squeeze: Option<SqueezeReport>,
     fit: NewReport,
@@ -566,7 +572,7 @@ impl Report for FitReport<'_> {
                 s.added_vertices
             )
         });
-        let smoothness = smoothness_text(&self.smoothness);
+        let smoothness = smoothness_text(&self.smoothness) + &agreement_text(&self.agreement);
         let squeeze = self
             .squeeze
             .as_ref()
@@ -615,4 +621,98 @@ fn smoothness_text(report: &SmoothnessReport) -> String {
         last.normals_p90,
         100.0 * last.residual,
     )
+}
+
+/// The line saying that the agreement weight was raised, and why (nothing where it was not).
+fn agreement_text(report: &AgreementReport) -> String {
+    let (Some(first), Some(kept)) = (
+        report.tried.first(),
+        report.tried.iter().find(|t| t.agreement == report.used),
+    ) else {
+        return String::new();
+    };
+    if report.used == report.asked {
+        return String::new();
+    }
+    let (Some((t, pairs)), Some((kept_t, _))) = (first.crossings, kept.crossings) else {
+        return String::new();
+    };
+    let (r0, r) = (first.roughness, kept.roughness);
+    format!(
+        "agreement: the patches' agreement weight raised from {} to {} (tried {}): at {} the \
+         surface crossed itself in {pairs} triangle pairs at t_e = t_r = {t}, at {} in none at \
+         {kept_t}; its patches {:.3}% → {:.3}% of the diagonal apart, |κ| {:.2}× → {:.2}× the \
+         mesh's, normals {:.1}° → {:.1}° (90%), residual {:.3}% → {:.3}%\n",
+        report.asked,
+        report.used,
+        report.tried[1..]
+            .iter()
+            .map(|t| t.agreement.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        report.asked,
+        report.used,
+        100.0 * r0.disagreement,
+        100.0 * r.disagreement,
+        r0.curvature_ratio,
+        r.curvature_ratio,
+        r0.normals_p90,
+        r.normals_p90,
+        100.0 * r0.residual,
+        100.0 * r.residual,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use embedding::mesh_fit::{AgreementTried, Roughness};
+
+    fn tried(agreement: f64, crossings: Option<(u32, usize)>, disagreement: f64) -> AgreementTried {
+        AgreementTried {
+            agreement,
+            crossings,
+            roughness: Roughness {
+                curvature_ratio: 3.85,
+                crease_rounding: None,
+                disagreement,
+                normals_p90: 3.8,
+                residual: 0.0066,
+            },
+        }
+    }
+
+    /// The agreement line names the weights, the crossings before and after and what else moved;
+    /// where the weight stayed as asked, or nothing was looked at, there is no line.
+    #[test]
+    fn the_agreement_line_says_why_it_was_raised() {
+        let raised = AgreementReport {
+            asked: 0.0,
+            used: 30.0,
+            tried: vec![
+                tried(0.0, Some((64, 18)), 0.00836),
+                tried(3.0, None, 0.02),
+                tried(30.0, Some((32, 0)), 0.0037),
+            ],
+        };
+        let line = agreement_text(&raised);
+        for part in [
+            "raised from 0 to 30 (tried 3, 30)",
+            "crossed itself in 18 triangle pairs at t_e = t_r = 64, at 30 in none at 32",
+            "patches 0.836% → 0.370% of the diagonal apart",
+        ] {
+            assert!(line.contains(part), "{part:?} not in {line:?}");
+        }
+        assert!(line.ends_with('\n') && line.lines().count() == 1);
+        let kept = AgreementReport {
+            used: 0.0,
+            ..raised.clone()
+        };
+        assert_eq!(agreement_text(&kept), "");
+        let untried = AgreementReport {
+            tried: Vec::new(),
+            ..raised
+        };
+        assert_eq!(agreement_text(&untried), "");
+    }
 }

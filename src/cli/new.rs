@@ -292,7 +292,7 @@ pub struct ShapeReport {
     /// What the normals are measured against.
     pub normals_from: NormalReference,
     /// Pairs of triangles of the t_e = t_r = `intersection_samples` tessellation that cross: the
-    /// first of [`INTERSECTION_SAMPLES`] without any, or the finest. `coarse_crossings` is how
+    /// first of [`embedding::quality::INTERSECTION_SAMPLES`] without any, or the finest. `coarse_crossings` is how
     /// many the first had when it was not that one (0 otherwise).
     pub self_intersections: usize,
     pub intersection_samples: u32,
@@ -347,12 +347,6 @@ pub const FINEST_DISTANCE_SAMPLES: u32 = 128;
 
 /// The tessellation the shape measures sample (t_e = t_r).
 const SHAPE_SAMPLES: u32 = 16;
-/// The tessellations whose triangles must not cross (t_e = t_r), tried in turn until one has no
-/// crossings (`embedding::quality::crossings_until_clear`). Coarse triangles cut across rims: at
-/// 16 a genus-10 plate's cross in 15 pairs and a genus-16 plate's in 598, at 32 the genus-16
-/// plate's in 36 and at 48 none, and the surface is embedded. A surface that crosses itself
-/// keeps its crossings at 64. (Genus 16: 1.7 s at 32, 3.9 s at 48, 6.9 s at 64.)
-pub const INTERSECTION_SAMPLES: [u32; 3] = [32, 48, 64];
 
 /// The shape measures; `dense` is the largest |κ| the Gauss–Bonnet check's quadrature found, and
 /// `flat_curvature` the |H| it found on a plate's flat faces.
@@ -399,7 +393,10 @@ fn measure_shape(
         FINEST_DISTANCE_SAMPLES,
     )?;
     stage("looking for self-intersections");
-    let crossings = quality::crossings_until_clear(surface, &INTERSECTION_SAMPLES)?;
+    let crossings = match fitted.crossings {
+        Some(known) => known.to_vec(),
+        None => quality::crossings_until_clear(surface, &quality::INTERSECTION_SAMPLES)?,
+    };
     let (first, last) = (crossings[0], crossings[crossings.len() - 1]);
     let (input_curvature, curvature_from) = match fitted.intended_max_curvature {
         Some(k) => (k, NormalReference::Intended),
@@ -560,6 +557,9 @@ pub struct Fitted<'a> {
     /// The surface's Gauss–Bonnet quadrature at `cells_per_knot`, where the fit already took it
     /// (`embedding::mesh_fit::MeshFit::integrals`); used where there are no flat faces to look at.
     pub integrals: Option<&'a embedding::integrals::SurfaceIntegrals>,
+    /// The surface's crossings at each of `embedding::quality::INTERSECTION_SAMPLES` up to the
+    /// first without, where the fit counted them (`MeshFit::crossings`).
+    pub crossings: Option<&'a [(u32, usize)]>,
 }
 
 /// A plate's flat faces: the input's vertices on them (`embedding::holed::HoledMesh::flat_vertices`),
@@ -601,6 +601,7 @@ pub fn check(
         agreement,
         edge_samples,
         integrals,
+        crossings: _,
     } = *fitted;
     let layout = surface.layout();
     let cells = cells_per_knot(layout.settings());
@@ -721,6 +722,7 @@ pub fn make(
         agreement: fit.agreement,
         edge_samples,
         integrals: None,
+        crossings: None,
     };
     let report = check(&checked, start, &|s| progress.stage(s))?;
     Ok(Made {
@@ -912,7 +914,8 @@ impl NewReport {
             coarse = if self.shape.coarse_crossings > 0 && self.shape.self_intersections == 0 {
                 format!(
                     "; {} at {}, whose triangles are coarse",
-                    self.shape.coarse_crossings, INTERSECTION_SAMPLES[0]
+                    self.shape.coarse_crossings,
+                    embedding::quality::INTERSECTION_SAMPLES[0]
                 )
             } else {
                 String::new()
