@@ -572,7 +572,8 @@ impl Report for FitReport<'_> {
                 s.added_vertices
             )
         });
-        let smoothness = smoothness_text(&self.smoothness) + &agreement_text(&self.agreement);
+        let smoothness = smoothness_text(&self.smoothness)
+            + &agreement_text(&self.agreement, self.smoothness.used);
         let squeeze = self
             .squeeze
             .as_ref()
@@ -624,7 +625,8 @@ fn smoothness_text(report: &SmoothnessReport) -> String {
 }
 
 /// The line saying that the agreement weight was raised, and why (nothing where it was not).
-fn agreement_text(report: &AgreementReport) -> String {
+/// `smoothness` is the λ kept.
+fn agreement_text(report: &AgreementReport, smoothness: f64) -> String {
     let (Some(first), Some(kept)) = (
         report.tried.first(),
         report.tried.iter().find(|t| t.agreement == report.used),
@@ -633,6 +635,18 @@ fn agreement_text(report: &AgreementReport) -> String {
     };
     if report.used == report.asked {
         return String::new();
+    }
+    // Raised by the smoothness ladder, at the λ it kept: the patches alone were too far apart.
+    if report.used == first.agreement {
+        return format!(
+            "agreement: the patches' agreement weight raised from {} to {} at λ = {smoothness}, \
+             where without it only the patches were more than {}% of the diagonal apart (now \
+             {:.3}%)\n",
+            report.asked,
+            report.used,
+            100.0 * embedding::quality::DISAGREEMENT_TOLERANCE,
+            100.0 * first.roughness.disagreement,
+        );
     }
     let (Some((t, pairs)), Some((kept_t, _))) = (first.crossings, kept.crossings) else {
         return String::new();
@@ -643,14 +657,14 @@ fn agreement_text(report: &AgreementReport) -> String {
          surface crossed itself in {pairs} triangle pairs at t_e = t_r = {t}, at {} in none at \
          {kept_t}; its patches {:.3}% → {:.3}% of the diagonal apart, |κ| {:.2}× → {:.2}× the \
          mesh's, normals {:.1}° → {:.1}° (90%), residual {:.3}% → {:.3}%\n",
-        report.asked,
+        first.agreement,
         report.used,
         report.tried[1..]
             .iter()
             .map(|t| t.agreement.to_string())
             .collect::<Vec<_>>()
             .join(", "),
-        report.asked,
+        first.agreement,
         report.used,
         100.0 * r0.disagreement,
         100.0 * r.disagreement,
@@ -695,7 +709,7 @@ mod tests {
                 tried(30.0, Some((32, 0)), 0.0037),
             ],
         };
-        let line = agreement_text(&raised);
+        let line = agreement_text(&raised, 0.01);
         for part in [
             "raised from 0 to 30 (tried 3, 30)",
             "crossed itself in 18 triangle pairs at t_e = t_r = 64, at 30 in none at 32",
@@ -708,11 +722,31 @@ mod tests {
             used: 0.0,
             ..raised.clone()
         };
-        assert_eq!(agreement_text(&kept), "");
+        assert_eq!(agreement_text(&kept, 0.01), "");
         let untried = AgreementReport {
             tried: Vec::new(),
             ..raised
         };
-        assert_eq!(agreement_text(&untried), "");
+        assert_eq!(agreement_text(&untried, 0.01), "");
+    }
+
+    /// Raised by the smoothness ladder (the first surface looked at for crossings already had the
+    /// raised weight): the line says at which λ, and that the patches alone were too far apart.
+    #[test]
+    fn the_agreement_line_names_the_rung_that_raised_it() {
+        let ladder = AgreementReport {
+            asked: 0.0,
+            used: 3.0,
+            tried: vec![tried(3.0, Some((32, 0)), 0.0011)],
+        };
+        let line = agreement_text(&ladder, 1.0);
+        for part in [
+            "raised from 0 to 3 at λ = 1,",
+            "only the patches were more than 1% of the diagonal apart (now 0.110%)",
+        ] {
+            assert!(line.contains(part), "{part:?} not in {line:?}");
+        }
+        assert!(!line.contains("crossed"), "{line:?}");
+        assert!(line.ends_with('\n') && line.lines().count() == 1);
     }
 }
