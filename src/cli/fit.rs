@@ -95,8 +95,8 @@ pub struct Args {
     /// middle across a sharp edge), so the surface follows the mesh between its vertices too
     /// (0: none; 1: a third of the vertices' weight; default 1, and 0 with --cage, whose limit mesh
     /// is dense already). At 1 the raw pretzel of issue 14's tests came from 0.61% to 0.57% of
-    /// the diagonal apart, and `gear-genus-1.obj` passes every check (its patches 2.2% apart
-    /// without);
+    /// the diagonal apart, and `gear-genus-1.obj` passes every check within 1.2% of the diagonal
+    /// (2.2% without, where its patches came 2.2% apart until the agreement rows were raised);
     /// a coarse mesh with sharp edges is followed more tightly (`plate-genus-3.obj`: 0.89% → 0.50%
     /// apart, its creases rounded to a radius of 0.89% of the diagonal instead of 3.3%, so λ rose
     /// to 0.25 and its |κ| from 1.10× to 2.04× its mesh's), and the fit takes longer (4 s → 9 s
