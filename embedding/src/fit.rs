@@ -71,6 +71,9 @@ pub struct Parameterization {
     /// Rounds of the sphere's map solved in the plane to even its area out, where they were taken
     /// (genus 0's long limbs; not the evening of a mesh of thin triangles); 0 elsewhere.
     pub planar_rounds: usize,
+    /// Whether the sphere's map was built coarse to fine (a limb the conformal map squeezed beyond
+    /// what its rounds undo: `sphere_map::progressive`) rather than from the conformal map.
+    pub coarse_to_fine: bool,
     /// Rounds of the sphere's density-equalizing flow whose map was taken (0: none, or not the
     /// sphere).
     pub equalizing_rounds: usize,
@@ -1512,6 +1515,7 @@ fn stereographic(atlas: &Atlas, mesh: &HoledMesh) -> Parameterization {
         folded: 0,
         sweeps: 0,
         planar_rounds: 0,
+        coarse_to_fine: false,
         equalizing_rounds: 0,
         newton: None,
         map_distortion: None,
@@ -1565,6 +1569,7 @@ fn flatten(
         folded,
         sweeps: solved.sweeps,
         planar_rounds: 0,
+        coarse_to_fine: false,
         equalizing_rounds: 0,
         newton: Some(solved),
         map_distortion: None,

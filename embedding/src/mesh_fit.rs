@@ -440,6 +440,7 @@ fn finish(
             folded: mapped.folded,
             sweeps: mapped.sweeps,
             planar_rounds: mapped.planar_rounds,
+            coarse_to_fine: mapped.coarse_to_fine,
             equalizing_rounds: mapped.equalizing_rounds,
             newton: mapped.solved,
             map_distortion: mapped.distortion,
@@ -954,6 +955,8 @@ struct Mapped {
     sweeps: usize,
     /// Rounds of the sphere's map solved in the plane (0 elsewhere).
     planar_rounds: usize,
+    /// Whether the sphere's map was built coarse to fine (false elsewhere).
+    coarse_to_fine: bool,
     /// Rounds of the sphere's density-equalizing flow taken (0 elsewhere).
     equalizing_rounds: usize,
     /// Newton's solve of the polygon's map (none for the sphere's).
@@ -997,6 +1000,7 @@ fn map_to_sphere(
         folded: map.folded,
         sweeps: map.sweeps,
         planar_rounds: map.planar_rounds,
+        coarse_to_fine: map.coarse_to_fine,
         equalizing_rounds: map.equalizing_rounds,
         solved: None,
         distortion: map.distortion,
@@ -1112,6 +1116,7 @@ fn map_to_polygon(
         folded,
         sweeps,
         planar_rounds: 0,
+        coarse_to_fine: false,
         equalizing_rounds: 0,
         solved: Some(solved),
         distortion,

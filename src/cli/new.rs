@@ -225,6 +225,8 @@ pub struct NewReport {
     pub sweeps: usize,
     /// Rounds of the sphere's map solved in the plane to even its area out, where taken.
     pub planar_rounds: usize,
+    /// Whether the sphere's map was built coarse to fine rather than from its conformal map.
+    pub coarse_to_fine: bool,
     /// Rounds of the sphere's density-equalizing flow, where taken.
     pub equalizing_rounds: usize,
     pub newton: Option<embedding::harmonic::Convergence>,
@@ -645,6 +647,7 @@ pub fn check(
         control_points: surface.control_points().len(),
         sweeps: parameterization.sweeps,
         planar_rounds: parameterization.planar_rounds,
+        coarse_to_fine: parameterization.coarse_to_fine,
         equalizing_rounds: parameterization.equalizing_rounds,
         newton: parameterization.newton,
         distortion: parameterization.distortion(positions, surface.atlas().geometry()),
@@ -807,6 +810,13 @@ impl NewReport {
                     .filter(|&(n, _, _)| n > 0)
                     .map(|(n, one, many)| count(n, one, many))
                     .collect();
+                if self.coarse_to_fine {
+                    let built = "built coarse to fine";
+                    return match later.is_empty() {
+                        true => built.into(),
+                        false => format!("{built}, then {}", later.join(" and ")),
+                    };
+                }
                 // A genus-0 map evened out in the plane runs no sweeps.
                 match (self.sweeps, later.is_empty()) {
                     (0, false) => later.join(" and "),
