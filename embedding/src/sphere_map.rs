@@ -241,15 +241,24 @@ fn built_coarse_to_fine(
     })
 }
 
-/// Whether a map of distortion `a` squeezes its worst triangle less than one of `b` (a map that
-/// could not be measured is no better than any).
+/// Whether a map of distortion `a` is more even than one of `b`: its worst triangle less squeezed,
+/// or, where the two are within [`SAME_SQUEEZE`] of each other, less sheared on average (a map
+/// that could not be measured is no better than any). The airplane of pymeshlab's samples: ×21.04
+/// at worst from the conformal path, ×21.15 coarse to fine but σ₁/σ₂ 3.5 against 4.5 on average;
+/// fitted through the second, its distance from the mesh fell from 0.73% of the diagonal to 0.45%.
 fn more_even(a: Option<&Distortion>, b: Option<&Distortion>) -> bool {
     match (a, b) {
+        (Some(a), Some(b)) if (a.area_max / b.area_max).ln().abs() <= SAME_SQUEEZE.ln() => {
+            a.angle_mean < b.angle_mean
+        }
         (Some(a), Some(b)) => a.area_max < b.area_max,
         (Some(_), None) => true,
         (None, _) => false,
     }
 }
+
+/// Worst area factors within this ratio of each other count as the same squeeze ([`more_even`]).
+const SAME_SQUEEZE: f64 = 1.1;
 
 /// The map relaxed on the sphere: rounds of mean value sweeps ([`Relaxation`]), the weights
 /// divided by the map's stretch from the second round on, each round kept only if it folds no

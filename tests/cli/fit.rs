@@ -679,7 +679,7 @@ fn a_cube_is_fitted_with_its_edges_rounded_and_written() {
 /// `CREASE_BAND` of one of its sharp edges, so there is no |κ| away from them to report, and the
 /// curvature line says so rather than "largest |κ| 0.00, 0.00× the input's" (as CGAL's coarse
 /// polygonal `double-torus-example.off` read). The rod itself does not fit (the sphere's map,
-/// built coarse to fine, squeezes it ×46 on average and ×850 at worst), and nothing is written.
+/// built coarse to fine, squeezes it ×45 on average and ×810 at worst), and nothing is written.
 #[test]
 fn a_mesh_that_is_all_sharp_edges_says_so_in_its_curvature_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -721,7 +721,7 @@ fn a_mesh_that_is_all_sharp_edges_says_so_in_its_curvature_line() {
     );
     assert!(!line.contains("largest |κ|"), "{line}");
     assert!(!path.exists());
-    // The map squeezes the rod (×850 at worst, measured), and the report says where, in the
+    // The map squeezes the rod (×810 at worst, measured), and the report says where, in the
     // file's coordinates: on the rod.
     let squeezed = text.lines().find(|l| l.starts_with("squeezed:")).unwrap();
     let numbers: Vec<f64> = squeezed

@@ -357,6 +357,7 @@ fn distortion_measures_known_maps() {
         folded: 0,
         sweeps: 0,
         planar_rounds: 0,
+        coarse_to_fine: false,
         equalizing_rounds: 0,
         newton: None,
         map_distortion: None,
