@@ -219,6 +219,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             max_residual_as_it_is: e.max_residual_as_it_is / fitted.mesh_diagonal,
             kept: e.kept,
         }),
+        sphere_choice: fitted.sphere_choice.map(|c| SphereChoiceReport {
+            max_residual_conformal: c.max_residual_conformal / fitted.mesh_diagonal,
+            max_residual_coarse_to_fine: c.max_residual_coarse_to_fine / fitted.mesh_diagonal,
+            kept_coarse_to_fine: c.kept_coarse_to_fine,
+        }),
         input: InputReport {
             path: args.mesh.display().to_string(),
             up: placement.up,
@@ -332,6 +337,8 @@ struct FitReport<'a> {
     loops: LoopsReport,
     /// How the mesh was evened out for its map, where it has long thin triangles.
     evening: Option<EveningReport>,
+    /// Genus 0: which of the sphere's two maps went on, where a rival was built coarse to fine.
+    sphere_choice: Option<SphereChoiceReport>,
     /// The smoothness weight asked for and used, and each one tried where it was raised.
     smoothness: SmoothnessReport,
     /// The agreement weight asked for and used, and each one tried where the surface crossed
@@ -436,6 +443,41 @@ struct EveningReport {
     max_residual_evened: f64,
     max_residual_as_it_is: f64,
     kept: bool,
+}
+
+/// Which of a genus-0 mesh's two maps onto the sphere went on.
+#[derive(Serialize)]
+struct SphereChoiceReport {
+    /// The largest residual of the fit through each map (fractions of the diagonal), and whether
+    /// the map built coarse to fine went on.
+    max_residual_conformal: f64,
+    max_residual_coarse_to_fine: f64,
+    kept_coarse_to_fine: bool,
+}
+
+impl SphereChoiceReport {
+    fn to_text(&self) -> String {
+        let (kept, kept_residual, other, other_residual) = if self.kept_coarse_to_fine {
+            let other = "through the conformal map's, which still squeezed part of the mesh";
+            let (a, b) = (
+                self.max_residual_coarse_to_fine,
+                self.max_residual_conformal,
+            );
+            ("built coarse to fine", a, other, b)
+        } else {
+            let other = "through its rival built coarse to fine";
+            let (a, b) = (
+                self.max_residual_conformal,
+                self.max_residual_coarse_to_fine,
+            );
+            ("the conformal map's", a, other, b)
+        };
+        format!(
+            "map: {kept} (its fit's largest residual {:.3}% of the diagonal, {:.3}% {other})\n",
+            100.0 * kept_residual,
+            100.0 * other_residual
+        )
+    }
 }
 
 /// The loop system the map was built on.
@@ -572,6 +614,10 @@ impl Report for FitReport<'_> {
                 s.added_vertices
             )
         });
+        let choice = self
+            .sphere_choice
+            .as_ref()
+            .map_or(String::new(), SphereChoiceReport::to_text);
         let smoothness = smoothness_text(&self.smoothness)
             + &agreement_text(&self.agreement, self.smoothness.used);
         let squeeze = self
@@ -579,7 +625,7 @@ impl Report for FitReport<'_> {
             .as_ref()
             .map_or(String::new(), SqueezeReport::to_text);
         format!(
-            "read {}{notes}\n{cage}{split}{loops}\n{evening}{smoothness}",
+            "read {}{notes}\n{cage}{split}{loops}\n{evening}{choice}{smoothness}",
             i.path
         ) + &self.fit.to_text()
             + &squeeze

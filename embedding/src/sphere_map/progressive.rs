@@ -35,9 +35,18 @@ const MAX_HOLE: usize = 5;
 /// Descent steps each vertex takes when it or a neighbour comes back.
 const LOCAL_STEPS: usize = 2;
 
-/// Whole-mesh passes of stretch descent are run each time the number of vertices back on the
-/// sphere grows by this factor, so the early, coarse layout keeps adapting as the mesh fills in.
+/// [`GROWTH_PASSES`] whole-mesh passes of descent are run each time the number of vertices back
+/// on the sphere grows by this factor, so the early, coarse layout keeps adapting as the mesh
+/// fills in.
 const PASS_GROWTH: f64 = 1.5;
+
+/// Passes run at each growth by [`PASS_GROWTH`]. One vertex's descent moves the map only locally,
+/// so a squeeze that spans a limb takes many passes to undo on the whole mesh, and few on a
+/// coarse one, where they cost little (at each growth, in all, about thrice the mesh's vertex
+/// count). CGAL's dino (3 916 vertices): with 1 pass a growth its worst triangle stayed ×2·10⁴
+/// after the final passes (its fit 6.0% of the diagonal from its mesh); with 10, ×84 (2.1%); with
+/// 30, ×42 (1.8%) in half as long again.
+const GROWTH_PASSES: usize = 10;
 
 /// Most whole-mesh passes once every vertex is back. The cow of pymeshlab's samples (3 043
 /// vertices with its long edges split) has its largest area factor at ×46 after 10, ×30 after
@@ -88,7 +97,9 @@ pub(super) fn progressive_map(
         back += 1;
         if back as f64 >= next_pass {
             next_pass = back as f64 * PASS_GROWTH;
-            energy.whole_pass(&mesh, &mut points);
+            for _ in 0..GROWTH_PASSES {
+                energy.whole_pass(&mesh, &mut points);
+            }
         }
     }
     let passes = FINAL_PASSES.min(FINAL_MOVES / positions.len().max(1));
