@@ -37,12 +37,12 @@
 //!    On the bunny it took the largest ratio to ×20, and the fit's distance from the mesh from
 //!    3.9% to 1.05% of the diagonal.
 //! 7. Where all that still squeezes a triangle more than ×[`COARSE_TO_FINE_FROM`] in area, or
-//!    leaves one folded, the map is built again without the conformal map: coarse to fine, from a
+//!    leaves one folded, a rival is built without the conformal map: coarse to fine, from a
 //!    tetrahedron, each vertex put back inside its hole and the whole kept at low symmetric
-//!    Dirichlet energy ([`progressive`]), then evened out by the same flow. The more even of the
-//!    two goes on. On pymeshlab's cow the conformal path left its tail's tip ×2·10⁸; built coarse
-//!    to fine its worst triangle is ×29 and the fit's distance from the mesh 2.4% of the diagonal
-//!    (from 8.8%).
+//!    Dirichlet energy ([`progressive`]), then evened out by the same flow. `mesh_fit` fits through
+//!    both and keeps the map whose fit comes closer to the mesh's vertices. On pymeshlab's cow the
+//!    conformal path left its tail's tip ×2·10⁸ and its fit 10.9% of the diagonal off at worst;
+//!    built coarse to fine its worst triangle is ×28 and its fit 1.4% off.
 //! 8. The map is turned so the caps' seam runs through the parts that stay squeezed, where each
 //!    cap's grid is densest ([`seam_through_squeezed`]).
 //!
@@ -98,11 +98,12 @@ pub(crate) struct SphereMap {
 }
 
 /// The largest area factor ([`Distortion::area_max`]) of a map from the conformal path above which
-/// a rival is built coarse to fine ([`progressive`]), for the fits through the two to choose from.
-/// Measured on pymeshlab's samples (conformal path → coarse to fine, worst triangle): the cow
-/// ×2·10⁸ → ×28, the airplane ×21 → ×27 (yet its fit 0.73% → 0.32% of the diagonal), the bunny
-/// ×20 → ×19 (its fit 0.49% → 1.6%, so its conformal map goes on); the bone (×4.7) and the
-/// dumbbell asset (×1.04) build none.
+/// a rival is built coarse to fine ([`progressive`]), for the fits through the two to choose from
+/// (`mesh_fit::mesh_model`). Measured on pymeshlab's samples (worst triangle, conformal path →
+/// coarse to fine; the fits' largest residuals): the cow ×2·10⁸ → ×28 (10.9% → 1.4% of the
+/// diagonal), the airplane ×21 → ×27 (0.72% → 0.52%), the bunny ×20 → ×19 (0.49% → 1.3%, so its
+/// conformal map goes on: the rival costs it 13 s of 35); the bone (×4.7) and the dumbbell asset
+/// (×1.04) build none.
 const COARSE_TO_FINE_FROM: f64 = 10.0;
 
 /// Rounds of stretch reweighting the sphere takes beyond what the settings ask of the polygon's maps:
@@ -1331,7 +1332,7 @@ mod tests {
     /// and one with a triangle turned the other way.
     #[test]
     fn a_map_built_coarse_to_fine_needs_a_closed_oriented_mesh() {
-        let (positions, _, mut triangles) = lat_long(8, 8, |d| Point3::from(d));
+        let (positions, _, mut triangles) = lat_long(8, 8, Point3::from);
         assert!(progressive::progressive_map(&positions, &triangles).is_some());
         let last = triangles.pop().unwrap();
         assert!(progressive::progressive_map(&positions, &triangles).is_none());

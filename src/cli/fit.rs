@@ -742,6 +742,31 @@ mod tests {
         }
     }
 
+    /// The map line names the map kept first with its own fit's residual, then the other's.
+    #[test]
+    fn the_map_line_names_the_map_kept_and_both_residuals() {
+        let built = SphereChoiceReport {
+            max_residual_conformal: 0.109,
+            max_residual_coarse_to_fine: 0.0142,
+            kept_coarse_to_fine: true,
+        };
+        assert_eq!(
+            built.to_text(),
+            "map: built coarse to fine (its fit's largest residual 1.420% of the diagonal, \
+             10.900% through the conformal map's, which still squeezed part of the mesh)\n"
+        );
+        let conformal = SphereChoiceReport {
+            max_residual_conformal: 0.00486,
+            max_residual_coarse_to_fine: 0.0129,
+            kept_coarse_to_fine: false,
+        };
+        assert_eq!(
+            conformal.to_text(),
+            "map: the conformal map's (its fit's largest residual 0.486% of the diagonal, \
+             1.290% through its rival built coarse to fine)\n"
+        );
+    }
+
     /// The agreement line names the weights, the crossings before and after and what else moved;
     /// where the weight stayed as asked, or nothing was looked at, there is no line.
     #[test]

@@ -11,15 +11,14 @@
 //!    over the surface, and a long limb keeps vertices in proportion to its area.
 //! 2. The tetrahedron goes onto the sphere as the regular one.
 //! 3. The vertices come back in reverse order. Each is put where its star's triangles are furthest
-//!    from turning over (the centre of its hole's kernel), then it and its ring are moved to lower
-//!    the map's L² stretch over their triangles (Sander, Snyder, Gortler and Hoppe 2001, with the
-//!    sphere as the domain). The stretch grows without bound as a triangle's image shrinks to
-//!    nothing, so it keeps every triangle the right way round, and it charges a squeezed triangle
-//!    most: the limbs keep room on the sphere as they come back.
+//!    from turning over (the centre of its hole's kernel), then it and its ring are moved down the
+//!    map's symmetric Dirichlet energy over their triangles ([`Energy`]), and every so often the
+//!    whole mesh is. The energy grows without bound as a triangle's image shrinks to nothing, so
+//!    it charges a squeezed triangle most, and the limbs keep room on the sphere as they come back.
 //!
 //! The conformal map squeezes a limb exponentially in its length over its girth (CGAL's dino ×10²⁰
-//! at its tail); built this way, the same mesh's map squeezes no triangle by more than a few
-//! hundred, and [`super::equalize_areas`] can even out from there.
+//! at its tail); built this way, the same mesh's map squeezes no triangle by more than ×84, and
+//! [`super::equalize_areas`] can even out from there.
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
@@ -48,10 +47,10 @@ const PASS_GROWTH: f64 = 1.5;
 /// 30, ×42 (1.8%) in half as long again.
 const GROWTH_PASSES: usize = 10;
 
-/// Most whole-mesh passes once every vertex is back. The cow of pymeshlab's samples (3 043
-/// vertices with its long edges split) has its largest area factor at ×46 after 10, ×30 after
-/// 200, ×25 after 500 and ×24 after 1 000, and its fit's distance from the mesh no nearer after
-/// 200.
+/// Most whole-mesh passes once every vertex is back. On pymeshlab's cow (3 043 vertices with its
+/// long edges split; measured with one pass a growth) the worst triangle after 10, 50, 200, 500
+/// and 1 000 final passes was ×313, ×51, ×46, ×46 and ×46, and the fit through the map came no
+/// closer to the mesh after 200 (4.9%, 3.4%, 2.1%, 2.3% and 2.3% of the diagonal).
 const FINAL_PASSES: usize = 300;
 
 /// Most vertex moves of the final passes together, so a large mesh takes fewer of them: 300
@@ -78,7 +77,6 @@ pub(super) fn progressive_map(
     triangles: &[[u32; 3]],
 ) -> Option<Vec<Vector3<f64>>> {
     let mut mesh = Connectivity::new(positions.len(), triangles)?;
-
     let removed = simplify(&mut mesh, positions)?;
     let mut points = vec![Vector3::zeros(); positions.len()];
     place_tetrahedron(&mesh, &mut points)?;
