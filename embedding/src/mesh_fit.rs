@@ -1464,7 +1464,7 @@ pub struct EvenReport {
 }
 
 /// Which of a genus-0 mesh's two maps onto the sphere went on: the conformal path's, still squeezed
-/// somewhere, or its rival built coarse to fine ([`crate::sphere_map`]).
+/// somewhere, or its rival built coarse to fine (`sphere_map.rs`).
 #[derive(Clone, Copy, Debug)]
 pub struct SphereChoice {
     /// The largest residual at the mesh's vertices of the fit through each (model units).
