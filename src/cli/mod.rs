@@ -134,7 +134,8 @@ struct FitArgs {
     /// input's points, where both blends are at least 0.05 (0: none; relative to the data term)
     /// [default: 0.3 for new's plates from genus 17, whose charts barely overlap, with disk grids
     /// at least five times the grid; 0 otherwise; `fit` raises it to 3, then 30, where the
-    /// surface crosses itself or only its patches are too far apart]
+    /// surface crosses itself or only its patches are too far apart, unless λ is given with
+    /// `--smoothness`: the fit's roughness, which that judges by, is then not measured]
     #[arg(long, value_name = "W", allow_negative_numbers = true, value_parser = parse_agreement)]
     agreement: Option<f64>,
 }
