@@ -372,7 +372,19 @@ impl SqueezeReport {
         placement: import::Placement,
     ) -> Option<SqueezeReport> {
         let map = fitted.parameterization.map_distortion?;
-        if fitted.genus != 0 || map.area_max <= embedding::mesh_fit::MAX_SQUEEZE_FOR_ARC_LENGTH {
+        Self::of_map(fitted.genus, map, positions, triangles, placement)
+    }
+
+    /// Where a genus-0 map of distortion `map` squeezes most, if it squeezes more than
+    /// `MAX_SQUEEZE_FOR_ARC_LENGTH`.
+    fn of_map(
+        genus: u32,
+        map: embedding::fit::Distortion,
+        positions: &[embedding::Point3],
+        triangles: &[[u32; 3]],
+        placement: import::Placement,
+    ) -> Option<SqueezeReport> {
+        if genus != 0 || map.area_max <= embedding::mesh_fit::MAX_SQUEEZE_FOR_ARC_LENGTH {
             return None;
         }
         let corners = triangles.get(map.area_max_triangle)?;
@@ -740,6 +752,45 @@ mod tests {
                 residual: 0.0066,
             },
         }
+    }
+
+    /// The squeezed line says where a genus-0 map squeezes more than ×100, at the middle of the
+    /// worst triangle in the file's coordinates (its up axis and units); nothing at ×100 or less,
+    /// or at genus 1.
+    #[test]
+    fn the_squeezed_line_says_where_in_the_file() {
+        let positions = [
+            [0.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [0.0, 3.0, 0.0],
+            [0.0, 0.0, 6.0],
+        ]
+        .map(|[x, y, z]| embedding::Point3::new(x, y, z));
+        let triangles = [[0, 2, 1], [0, 1, 3]];
+        let map = |area_max| embedding::fit::Distortion {
+            angle_mean: 2.0,
+            angle_max: 9.0,
+            area_mean: 3.0,
+            area_max,
+            area_max_triangle: 1,
+        };
+        // The file was read +y up in millimetres: the model is its z-up copy, in centimetres.
+        let placement = import::Placement {
+            up: ntori::io::export::Up::Y,
+            factor: 0.1,
+        };
+        let report = SqueezeReport::of_map(0, map(2.5e3), &positions, &triangles, placement);
+        let report = report.expect("squeezed more than ×100");
+        // The worst triangle's middle (1, 0, 2) in the model is (10, 20, 0) in the file.
+        assert_eq!(report.at, [10.0, 20.0, 0.0]);
+        assert_eq!(
+            report.to_text(),
+            "squeezed: the sphere's map still distorts area ×2.50e3 near (10.0000, 20.0000, \
+             -0.0000) in the file: a limb or tail many times longer than thick, which the fit \
+             follows poorly there\n"
+        );
+        assert!(SqueezeReport::of_map(0, map(100.0), &positions, &triangles, placement).is_none());
+        assert!(SqueezeReport::of_map(1, map(2.5e3), &positions, &triangles, placement).is_none());
     }
 
     /// The map line names the map kept first with its own fit's residual, then the other's.

@@ -4,9 +4,10 @@
 //! remeshing", 2003, for the stretch each insertion is smoothed by).
 //!
 //! 1. The mesh is simplified one vertex at a time down to a tetrahedron. Each step takes out a
-//!    vertex of degree 3, 4 or 5 and fills its hole with a fan. A hole of at most five sides is
+//!    vertex of degree at most 5 and fills its hole with a fan. A hole of at most five sides is
 //!    star-shaped wherever the coarser map draws it without overlap (one guard sees any simple
-//!    polygon of five sides or fewer), so the vertex can always come back inside it. The vertex
+//!    polygon of five sides or fewer), so the vertex has room to come back inside it (up to
+//!    rounding: where none is found, no map is made). The vertex
 //!    whose star has least area goes first: the coarse meshes keep their vertices spread evenly
 //!    over the surface, and a long limb keeps vertices in proportion to its area.
 //! 2. The tetrahedron goes onto the sphere as the regular one.
@@ -17,7 +18,7 @@
 //!    it charges a squeezed triangle most, and the limbs keep room on the sphere as they come back.
 //!
 //! The conformal map squeezes a limb exponentially in its length over its girth (CGAL's dino ×10²⁰
-//! at its tail); built this way, the same mesh's map squeezes no triangle by more than ×84, and
+//! at its tail); built this way, the same mesh's map squeezes no triangle by more than ×87, and
 //! [`super::equalize_areas`] can even out from there.
 
 use std::cmp::Reverse;
@@ -41,14 +42,15 @@ const PASS_GROWTH: f64 = 1.5;
 
 /// Passes run at each growth by [`PASS_GROWTH`]. One vertex's descent moves the map only locally,
 /// so a squeeze that spans a limb takes many passes to undo on the whole mesh, and few on a
-/// coarse one, where they cost little (at each growth, in all, about thrice the mesh's vertex
-/// count). CGAL's dino (3 916 vertices): with 1 pass a growth its worst triangle stayed ×2·10⁴
-/// after the final passes (its fit 6.0% of the diagonal from its mesh); with 10, ×84 (2.1%); with
-/// 30, ×42 (1.8%) in half as long again.
+/// coarse one, where they cost little (over all growths, about 30 vertex moves per vertex of the
+/// mesh). CGAL's dino (3 916 vertices), measured with an earlier form of [`Energy`] (its two
+/// terms weighed by the mesh's units): with 1 pass a growth its worst triangle stayed ×2·10⁴ after
+/// the final passes (its fit 6.0% of the diagonal from its mesh); with 10, ×84 (2.1%); with 30,
+/// ×42 (1.8%) in half as long again.
 const GROWTH_PASSES: usize = 10;
 
 /// Most whole-mesh passes once every vertex is back. On pymeshlab's cow (3 043 vertices with its
-/// long edges split; measured with one pass a growth) the worst triangle after 10, 50, 200, 500
+/// long edges split; measured with one pass a growth and the earlier energy) the worst triangle after 10, 50, 200, 500
 /// and 1 000 final passes was ×313, ×51, ×46, ×46 and ×46, and the fit through the map came no
 /// closer to the mesh after 200 (4.9%, 3.4%, 2.1%, 2.3% and 2.3% of the diagonal).
 const FINAL_PASSES: usize = 300;
@@ -420,6 +422,8 @@ struct Energy<'a> {
     positions: &'a [Point3],
     /// The sphere's area over the surface's.
     scale: f64,
+    /// The least scaled area a triangle of the mesh counts with: 10⁻¹² of the mean.
+    least_area: f64,
 }
 
 impl<'a> Energy<'a> {
@@ -431,9 +435,11 @@ impl<'a> Energy<'a> {
                 (b - a).cross(&(c - a)).norm() / 2.0
             })
             .sum();
+        let sphere = 4.0 * std::f64::consts::PI;
         Energy {
             positions,
-            scale: 4.0 * std::f64::consts::PI / area.max(f64::MIN_POSITIVE),
+            scale: sphere / area.max(f64::MIN_POSITIVE),
+            least_area: 1e-12 * sphere / triangles.len().max(1) as f64,
         }
     }
 
@@ -480,11 +486,13 @@ impl<'a> Energy<'a> {
         let around: Vec<Point3> = ring.iter().map(|&r| self.positions[r as usize]).collect();
         let x = self.positions[v as usize];
         let energy = |p: Vector2<f64>| self.star(p, &flat, x, &around);
+        // The fold test the finished map is checked by (`orientation`'s form, which keeps its
+        // sign on triangles squeezed to 1e-8 and less, where q·(a × b) is lost to rounding).
         let unfolded = |q: Vector3<f64>| {
             let d = ring.len();
             (0..d).all(|i| {
                 let (a, b) = (points[ring[i] as usize], points[ring[(i + 1) % d] as usize]);
-                q.dot(&a.cross(&b)) > 0.0
+                (a - q).cross(&(b - q)).dot(&(q + a + b)) > 0.0
             })
         };
         let size = flat.iter().map(|w| w.norm()).sum::<f64>() / flat.len() as f64;
@@ -546,11 +554,14 @@ impl<'a> Energy<'a> {
                 + q[2].coords * (s[1].x - s[0].x))
                 / doubled;
             let area = (q[1] - q[0]).cross(&(q[2] - q[0])).norm() / 2.0;
-            // |J|² + |J⁻¹|² with |J⁻¹|² = |J|² / det J², det J the ratio of the areas; the space's
-            // area floored so a degenerate triangle of the mesh does not divide by zero.
+            // With the surface scaled by the sphere's area over its own (k): area·(|J|² + |J⁻¹|²)
+            // = k·area·k|J|² + |J|²·image²/area, k times this sum; |J⁻¹|² = |J|² / det J², det J
+            // the ratio of the areas. The scaled area is floored, so a degenerate triangle of the
+            // mesh neither divides by zero nor freezes its corners.
             let squared = along_s.norm_squared() + along_t.norm_squared();
             let image = doubled / 2.0;
-            sum += squared * (self.scale * area + image * image / area.max(f64::MIN_POSITIVE));
+            let scaled = (self.scale * area).max(self.least_area);
+            sum += squared * (scaled + image * image / scaled);
         }
         sum
     }
