@@ -890,12 +890,7 @@ fn punctured_map(
     puncture: [u32; 3],
 ) -> Result<Vec<Vector3<f64>>, EmbeddingError> {
     let c = centroid(points, &puncture);
-    // Any orthonormal frame of the plane through the origin perpendicular to c.
-    let e1 = c
-        .cross(&Vector3::x())
-        .try_normalize(1e-6)
-        .unwrap_or_else(|| c.cross(&Vector3::y()).normalize());
-    let e2 = c.cross(&e1);
+    let (e1, e2) = tangent_frame(c);
     let project = |x: Vector3<f64>| {
         let gap = (1.0 - x.dot(&c)).max(f64::MIN_POSITIVE);
         [x.dot(&e1) / gap, x.dot(&e2) / gap]
@@ -1029,7 +1024,22 @@ fn ball_isometry(a: Vector3<f64>, x: Vector3<f64>) -> Vector3<f64> {
 /// a·(b × c) of three nearly equal unit vectors is lost to rounding.
 fn orientation(points: &[Vector3<f64>], t: &[u32; 3]) -> f64 {
     let [a, b, c] = t.map(|v| points[v as usize]);
+    orientation_of(a, b, c)
+}
+
+/// [`orientation`] of the triangle with corners a, b, c on the sphere.
+fn orientation_of(a: Vector3<f64>, b: Vector3<f64>, c: Vector3<f64>) -> f64 {
     (b - a).cross(&(c - a)).dot(&(a + b + c)) / 3.0
+}
+
+/// An orthonormal frame (e1, e2) of the plane through the origin perpendicular to unit vector c,
+/// with (e1, e2, c) right-handed.
+fn tangent_frame(c: Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let e1 = c
+        .cross(&Vector3::x())
+        .try_normalize(1e-6)
+        .unwrap_or_else(|| c.cross(&Vector3::y()).normalize());
+    (e1, c.cross(&e1))
 }
 
 /// Per vertex: √(3D area / spherical area) of its triangles, relative to the whole surface's ratio.

@@ -469,24 +469,24 @@ struct SphereChoiceReport {
 
 impl SphereChoiceReport {
     fn to_text(&self) -> String {
-        let (kept, kept_residual, other, other_residual) = if self.kept_coarse_to_fine {
+        let (built, conformal) = (
+            self.max_residual_coarse_to_fine,
+            self.max_residual_conformal,
+        );
+        let (kept, residual, other, other_residual) = if self.kept_coarse_to_fine {
             let other = "through the conformal map's, which still squeezed part of the mesh";
-            let (a, b) = (
-                self.max_residual_coarse_to_fine,
-                self.max_residual_conformal,
-            );
-            ("built coarse to fine", a, other, b)
+            ("built coarse to fine", built, other, conformal)
         } else {
-            let other = "through its rival built coarse to fine";
-            let (a, b) = (
-                self.max_residual_conformal,
-                self.max_residual_coarse_to_fine,
-            );
-            ("the conformal map's", a, other, b)
+            (
+                "the conformal map's",
+                conformal,
+                "through its rival built coarse to fine",
+                built,
+            )
         };
         format!(
             "map: {kept} (its fit's largest residual {:.3}% of the diagonal, {:.3}% {other})\n",
-            100.0 * kept_residual,
+            100.0 * residual,
             100.0 * other_residual
         )
     }

@@ -811,11 +811,12 @@ impl NewReport {
                     .map(|(n, one, many)| count(n, one, many))
                     .collect();
                 if self.coarse_to_fine {
-                    let built = "built coarse to fine";
-                    return match later.is_empty() {
-                        true => built.into(),
-                        false => format!("{built}, then {}", later.join(" and ")),
+                    let then = if later.is_empty() {
+                        String::new()
+                    } else {
+                        format!(", then {}", later.join(" and "))
                     };
+                    return format!("built coarse to fine{then}");
                 }
                 // A genus-0 map evened out in the plane runs no sweeps.
                 match (self.sweeps, later.is_empty()) {

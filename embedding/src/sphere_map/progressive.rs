@@ -26,7 +26,7 @@ use std::collections::{BinaryHeap, HashMap};
 
 use nalgebra::{Vector2, Vector3};
 
-use super::{from_frame, orientation, to_frame};
+use super::{folded_triangles, from_frame, orientation, orientation_of, tangent_frame, to_frame};
 use crate::surface::Point3;
 
 /// The largest hole a removed vertex leaves: five sides, the most that are always star-shaped.
@@ -108,11 +108,7 @@ pub(super) fn progressive_map(
             break;
         }
     }
-    let folded = triangles
-        .iter()
-        .filter(|t| orientation(&points, t) <= 0.0)
-        .count();
-    (folded == 0).then_some(points)
+    (folded_triangles(&points, triangles) == 0).then_some(points)
 }
 
 /// One step of the simplification: `vertex` was taken out of the hole bounded by `ring`
@@ -472,11 +468,7 @@ impl<'a> Energy<'a> {
         {
             return;
         }
-        let e1 = c
-            .cross(&Vector3::x())
-            .try_normalize(1e-6)
-            .unwrap_or_else(|| c.cross(&Vector3::y()).normalize());
-        let e2 = c.cross(&e1);
+        let (e1, e2) = tangent_frame(c);
         let plane = |q: Vector3<f64>| {
             let d = to_frame(c, q) * 2.0;
             Vector2::new(d.dot(&e1), d.dot(&e2))
@@ -486,13 +478,13 @@ impl<'a> Energy<'a> {
         let around: Vec<Point3> = ring.iter().map(|&r| self.positions[r as usize]).collect();
         let x = self.positions[v as usize];
         let energy = |p: Vector2<f64>| self.star(p, &flat, x, &around);
-        // The fold test the finished map is checked by (`orientation`'s form, which keeps its
-        // sign on triangles squeezed to 1e-8 and less, where q·(a × b) is lost to rounding).
+        // The fold test the finished map is checked by, which keeps its sign on triangles
+        // squeezed to 1e-8 and less, where q·(a × b) is lost to rounding.
         let unfolded = |q: Vector3<f64>| {
             let d = ring.len();
             (0..d).all(|i| {
                 let (a, b) = (points[ring[i] as usize], points[ring[(i + 1) % d] as usize]);
-                (a - q).cross(&(b - q)).dot(&(q + a + b)) > 0.0
+                orientation_of(q, a, b) > 0.0
             })
         };
         let size = flat.iter().map(|w| w.norm()).sum::<f64>() / flat.len() as f64;
