@@ -397,6 +397,9 @@ pub enum FitStage {
         round: usize,
         rounds: usize,
     },
+    /// Genus 0: building a second map onto the sphere, coarse to fine, where the fit through the
+    /// first did not pass.
+    MappingCoarseToFine,
     /// The least-squares fit of the control points.
     Fitting,
 }
@@ -413,6 +416,9 @@ impl std::fmt::Display for FitStage {
                     f,
                     "relaxing the map on the surface (round {round} of {rounds})"
                 )
+            }
+            FitStage::MappingCoarseToFine => {
+                write!(f, "mapping the mesh onto the sphere again, coarse to fine")
             }
             FitStage::Fitting => write!(f, "fitting the control points"),
         }

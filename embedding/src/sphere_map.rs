@@ -40,9 +40,10 @@
 //!    leaves one folded, a rival is built without the conformal map: coarse to fine, from a
 //!    tetrahedron, each vertex put back inside its hole and the whole kept at low symmetric
 //!    Dirichlet energy ([`progressive`]), then evened out by the same flow. Where the conformal
-//!    path's map folds, the rival replaces it; elsewhere `mesh_fit` fits through both and keeps
-//!    the map whose fit is smooth enough, where only one is, else the one that comes closer to the
-//!    mesh's vertices. On pymeshlab's cow the
+//!    path's map folds, the rival replaces it; elsewhere `mesh_fit` fits through the conformal
+//!    path's map first, and where that fit fails what it measures, builds the rival, fits through
+//!    it too and keeps the map whose fit is smooth enough, where only one is, else the one that
+//!    comes closer to the mesh's vertices. On pymeshlab's cow the
 //!    conformal path left its tail's tip ×2·10⁸ and its fit 10.9% of the diagonal off at worst;
 //!    built coarse to fine its worst triangle is ×16 and its fit 1.2% off.
 //! 8. The map is turned so the caps' seam runs through the parts that stay squeezed, where each
@@ -104,8 +105,9 @@ pub(crate) struct SphereMap {
 /// (`mesh_fit::mesh_model`). Measured on pymeshlab's samples (worst triangle, conformal path →
 /// coarse to fine; the fits' largest residuals): the cow ×2·10⁸ → ×16 (10.9% → 1.2% of the
 /// diagonal), the airplane ×21 → ×4.3 (0.72% → 0.30%), the bunny ×20 → ×6.8 (0.49% → 1.3%, so its
-/// conformal map goes on: the rival costs it 14 s of 35); the bone (×4.7) and the dumbbell asset
-/// (×1.04) build none.
+/// conformal map goes on; since its fit passes within `mesh_fit::RIVAL_NEEDLESS_WITHIN`, its rival
+/// is not even built, which halves its time: 24–25 s against 47–54 s); the bone (×4.7) and the
+/// dumbbell asset (×1.04) have none.
 const COARSE_TO_FINE_FROM: f64 = 10.0;
 
 /// Rounds of stretch reweighting the sphere takes beyond what the settings ask of the polygon's maps:
@@ -125,7 +127,7 @@ pub(crate) struct Relaxation {
 }
 
 /// The map of a genus-0 mesh onto the sphere, evened out in the plane or relaxed there with
-/// `relaxation`, and its rival built coarse to fine where it is still squeezed. `areas` are the
+/// `relaxation`, and its rival, to be built coarse to fine, where it is still squeezed. `areas` are the
 /// mesh's vertex areas (the mass that is centred).
 pub(crate) fn sphere_map(
     positions: &[Point3],
@@ -194,7 +196,10 @@ pub(crate) fn sphere_map(
     let squeezed = distortion
         .as_ref()
         .is_none_or(|d| d.area_max > COARSE_TO_FINE_FROM);
-    let built = (folded > 0 || squeezed)
+    // A folded map is replaced at once; a squeezed one's rival costs about as much as the map
+    // itself on a large mesh, so it is built only where the fit through this map asks for it
+    // ([`Rival::build`]).
+    let built = (folded > 0)
         .then(|| built_coarse_to_fine(positions, triangles, areas, &weights))
         .flatten();
     seam_through_squeezed(&mut points, triangles, areas);
@@ -208,24 +213,45 @@ pub(crate) fn sphere_map(
         equalizing_rounds: equalized,
     };
     Ok(match built {
-        Some(built) if folded > 0 => SphereMaps {
+        Some(built) => SphereMaps {
             map: built,
             rival: None,
         },
-        rival => SphereMaps {
+        None => SphereMaps {
             map: conformal,
-            rival,
+            rival: (folded == 0 && squeezed).then_some(Rival { weights }),
         },
     })
 }
 
 /// The maps of a genus-0 mesh onto the sphere ([`sphere_map`]): the one from its conformal map
-/// and, where that still squeezes or folds, a rival built coarse to fine (the map itself where the
-/// conformal path's folds).
+/// (or built coarse to fine, where the conformal path's folds) and, where that still squeezes,
+/// its rival to be built coarse to fine when asked.
 #[derive(Clone, Debug)]
 pub(crate) struct SphereMaps {
     pub map: SphereMap,
-    pub rival: Option<SphereMap>,
+    pub rival: Option<Rival>,
+}
+
+/// A squeezed map's rival, not yet built: [`Rival::build`] costs about as much as the conformal
+/// path on a large mesh, so it is built only where the fit through that path's map asks for it.
+#[derive(Clone, Debug)]
+pub(crate) struct Rival {
+    /// The mesh's mean value weights.
+    weights: Vec<Vec<(u32, f64)>>,
+}
+
+impl Rival {
+    /// The map built coarse to fine for the mesh [`sphere_map`] was given; None where it cannot
+    /// be built.
+    pub fn build(
+        &self,
+        positions: &[Point3],
+        triangles: &[[u32; 3]],
+        areas: &[f64],
+    ) -> Option<SphereMap> {
+        built_coarse_to_fine(positions, triangles, areas, &self.weights)
+    }
 }
 
 /// The mesh mapped coarse to fine ([`progressive::progressive_map`]), evened out by
