@@ -36,12 +36,12 @@
 //!    ratio, every vertex moved down its gradient, each round kept free of folds and of needles.
 //!    On the bunny it took the largest ratio to ×20, and the fit's distance from the mesh from
 //!    3.9% to 1.05% of the diagonal.
-//! 7. Where all that still squeezes a triangle more than ×[`COARSE_TO_FINE_FROM`] in area, or
-//!    leaves one folded, a rival is built without the conformal map: coarse to fine, from a
-//!    tetrahedron, each vertex put back inside its hole and the whole kept at low symmetric
-//!    Dirichlet energy ([`progressive`]), then evened out by the same flow. Where the conformal
-//!    path's map folds, the rival replaces it; elsewhere `mesh_fit` fits through the conformal
-//!    path's map first, and where that fit fails what it measures, builds the rival, fits through
+//! 7. All that can leave a limb squeezed, or sheared, or a triangle folded. A rival is made
+//!    without the conformal map: coarse to fine, from a tetrahedron, each vertex put back inside
+//!    its hole and the whole kept at low symmetric Dirichlet energy ([`progressive`]), then
+//!    evened out by the same flow. Where the conformal path's map folds, the rival replaces it;
+//!    elsewhere `mesh_fit` fits through the conformal path's map first, and where that fit fails
+//!    what it measures or is more than 0.5% of the diagonal off, builds the rival, fits through
 //!    it too and keeps the map whose fit is smooth enough, where only one is, else the one that
 //!    comes closer to the mesh's vertices. On pymeshlab's cow the
 //!    conformal path left its tail's tip ×2·10⁸ and its fit 10.9% of the diagonal off at worst;
@@ -100,16 +100,6 @@ pub(crate) struct SphereMap {
     pub distortion: Option<Distortion>,
 }
 
-/// The largest area factor ([`Distortion::area_max`]) of a map from the conformal path above which
-/// a rival is built coarse to fine ([`progressive`]), for the fits through the two to choose from
-/// (`mesh_fit::mesh_model`). Measured on pymeshlab's samples (worst triangle, conformal path →
-/// coarse to fine; the fits' largest residuals): the cow ×2·10⁸ → ×16 (10.9% → 1.2% of the
-/// diagonal), the airplane ×21 → ×4.3 (0.72% → 0.30%), the bunny ×20 → ×6.8 (0.49% → 1.3%, so its
-/// conformal map goes on; since its fit passes within `mesh_fit::RIVAL_NEEDLESS_WITHIN`, its rival
-/// is not even built, which halves its time: 24–25 s against 47–54 s); the bone (×4.7) and the
-/// dumbbell asset (×1.04) have none.
-const COARSE_TO_FINE_FROM: f64 = 10.0;
-
 /// Rounds of stretch reweighting the sphere takes beyond what the settings ask of the polygon's maps:
 /// the sphere's conformal map squeezes the ends of a long shape far more than the polygon's maps
 /// squeeze a plate (an ellipsoid 2.8 : 1 with lobes fitted to 1.5% of its diagonal with one round,
@@ -127,7 +117,7 @@ pub(crate) struct Relaxation {
 }
 
 /// The map of a genus-0 mesh onto the sphere, evened out in the plane or relaxed there with
-/// `relaxation`, and its rival, to be built coarse to fine, where it is still squeezed. `areas` are the
+/// `relaxation`, and its rival, to be built coarse to fine when asked. `areas` are the
 /// mesh's vertex areas (the mass that is centred).
 pub(crate) fn sphere_map(
     positions: &[Point3],
@@ -189,16 +179,11 @@ pub(crate) fn sphere_map(
             distortion = self::distortion(&points, positions, triangles);
         }
     }
-    // The conformal map squeezes a long limb exponentially in its length over its girth; where the
-    // rounds above leave it squeezed beyond COARSE_TO_FINE_FROM (the cow's tail ×2·10⁸) or folded,
-    // a map built without passing through that squeeze is made too. A folded map is no rival;
-    // otherwise the fits through the two say which goes on (`mesh_fit::mesh_model`).
-    let squeezed = distortion
-        .as_ref()
-        .is_none_or(|d| d.area_max > COARSE_TO_FINE_FROM);
-    // A folded map is replaced at once; a squeezed one's rival costs about as much as the map
-    // itself on a large mesh, so it is built only where the fit through this map asks for it
-    // ([`Rival::build`]).
+    // The conformal map squeezes a long limb exponentially in its length over its girth, and the
+    // rounds above leave it squeezed (the cow's tail ×2·10⁸) or sheared (the bone's ends); a map
+    // built coarse to fine never passes through that squeeze. Where this one folds, that one
+    // replaces it at once; elsewhere it is its rival, built only where the fit through this map
+    // asks for it (`mesh_fit::mesh_model`), as it costs about as much as this map on a large mesh.
     let built = (folded > 0)
         .then(|| built_coarse_to_fine(positions, triangles, areas, &weights))
         .flatten();
@@ -219,22 +204,23 @@ pub(crate) fn sphere_map(
         },
         None => SphereMaps {
             map: conformal,
-            rival: (folded == 0 && squeezed).then_some(Rival { weights }),
+            rival: (folded == 0).then_some(Rival { weights }),
         },
     })
 }
 
 /// The maps of a genus-0 mesh onto the sphere ([`sphere_map`]): the one from its conformal map
-/// (or built coarse to fine, where the conformal path's folds) and, where that still squeezes,
-/// its rival to be built coarse to fine when asked.
+/// (or built coarse to fine, where the conformal path's folds) and, where it is the conformal
+/// path's, its rival, to be built coarse to fine when asked.
 #[derive(Clone, Debug)]
 pub(crate) struct SphereMaps {
     pub map: SphereMap,
     pub rival: Option<Rival>,
 }
 
-/// A squeezed map's rival, not yet built: [`Rival::build`] costs about as much as the conformal
-/// path on a large mesh, so it is built only where the fit through that path's map asks for it.
+/// The conformal path's map's rival, not yet built: [`Rival::build`] costs about as much as the
+/// conformal path on a large mesh, so it is built only where the fit through that path's map asks
+/// for it.
 #[derive(Clone, Debug)]
 pub(crate) struct Rival {
     /// The mesh's mean value weights.

@@ -221,9 +221,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }),
         sphere_choice: fitted.sphere_choice.map(|c| SphereChoiceReport {
             max_residual_conformal: c.max_residual_conformal / fitted.mesh_diagonal,
-            max_residual_coarse_to_fine: c
-                .max_residual_coarse_to_fine
-                .map(|r| r / fitted.mesh_diagonal),
+            max_residual_coarse_to_fine: c.max_residual_coarse_to_fine / fitted.mesh_diagonal,
             kept_coarse_to_fine: c.kept_coarse_to_fine,
         }),
         input: InputReport {
@@ -462,24 +460,19 @@ struct EveningReport {
 /// Which of a genus-0 mesh's two maps onto the sphere went on.
 #[derive(Serialize)]
 struct SphereChoiceReport {
-    /// The largest residual of the fit through each map (fractions of the diagonal; null through
-    /// the map built coarse to fine where the conformal map's fit passed what it measured, so that
-    /// map was not built), and whether the map built coarse to fine went on.
+    /// The largest residual of the fit through each map (fractions of the diagonal), and whether
+    /// the map built coarse to fine went on.
     max_residual_conformal: f64,
-    max_residual_coarse_to_fine: Option<f64>,
+    max_residual_coarse_to_fine: f64,
     kept_coarse_to_fine: bool,
 }
 
 impl SphereChoiceReport {
     fn to_text(&self) -> String {
-        let conformal = self.max_residual_conformal;
-        let Some(built) = self.max_residual_coarse_to_fine else {
-            return format!(
-                "map: the conformal map's (its fit's largest residual {:.3}% of the diagonal; the \
-                 fit passed its checks, so no rival was built coarse to fine)\n",
-                100.0 * conformal
-            );
-        };
+        let (built, conformal) = (
+            self.max_residual_coarse_to_fine,
+            self.max_residual_conformal,
+        );
         let (kept, residual, other, other_residual) = if self.kept_coarse_to_fine {
             let other = "through the conformal map's, which still squeezed part of the mesh";
             ("built coarse to fine", built, other, conformal)
@@ -800,13 +793,12 @@ mod tests {
         assert!(SqueezeReport::of_map(1, map(2.5e3), &positions, &triangles, placement).is_none());
     }
 
-    /// The map line names the map kept first with its own fit's residual, then the other's, or
-    /// says why there was no other.
+    /// The map line names the map kept first with its own fit's residual, then the other's.
     #[test]
     fn the_map_line_names_the_map_kept_and_both_residuals() {
         let built = SphereChoiceReport {
             max_residual_conformal: 0.109,
-            max_residual_coarse_to_fine: Some(0.0142),
+            max_residual_coarse_to_fine: 0.0142,
             kept_coarse_to_fine: true,
         };
         assert_eq!(
@@ -816,22 +808,13 @@ mod tests {
         );
         let conformal = SphereChoiceReport {
             max_residual_conformal: 0.00486,
-            max_residual_coarse_to_fine: Some(0.0129),
+            max_residual_coarse_to_fine: 0.0129,
             kept_coarse_to_fine: false,
         };
         assert_eq!(
             conformal.to_text(),
             "map: the conformal map's (its fit's largest residual 0.486% of the diagonal, \
              1.290% through its rival built coarse to fine)\n"
-        );
-        let alone = SphereChoiceReport {
-            max_residual_coarse_to_fine: None,
-            ..conformal
-        };
-        assert_eq!(
-            alone.to_text(),
-            "map: the conformal map's (its fit's largest residual 0.486% of the diagonal; the fit \
-             passed its checks, so no rival was built coarse to fine)\n"
         );
     }
 
