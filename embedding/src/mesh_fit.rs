@@ -436,10 +436,10 @@ impl MeshFit {
     /// measured ([`Roughness`] and crossings, where the settings ask for them: `ntori fit`'s checks
     /// as far as the fit can tell).
     fn needs_no_rival(&self) -> bool {
-        let clear = |c: &Vec<(u32, usize)>| c.last().is_some_and(|&(_, pairs)| pairs == 0);
+        let clear = |c: &[(u32, usize)]| c.last().is_some_and(|&(_, pairs)| pairs == 0);
         self.max_residual <= RIVAL_NEEDLESS_WITHIN * self.mesh_diagonal
             && self.smoothness.passed()
-            && self.crossings.as_ref().is_none_or(clear)
+            && self.crossings.as_deref().is_none_or(clear)
     }
 }
 
@@ -1055,7 +1055,8 @@ struct Mapped {
 }
 
 /// Genus 0: the mesh mapped onto the unit sphere ([`sphere_map`]), read in the sphere's two caps,
-/// and its rival, to be built coarse to fine, where that is still squeezed.
+/// and its rival, to be built coarse to fine when the fit asks (none where the conformal path folded
+/// and the map is the one built coarse to fine).
 fn map_to_sphere(
     atlas: &Atlas,
     positions: &[Point3],
@@ -1526,8 +1527,9 @@ pub struct EvenReport {
     pub kept: bool,
 }
 
-/// Which of a genus-0 mesh's two maps onto the sphere went on: the conformal path's, still squeezed
-/// somewhere, or its rival built coarse to fine (`sphere_map.rs`).
+/// Which of a genus-0 mesh's two maps onto the sphere went on, where the fit through the conformal
+/// path's did not pass within [`RIVAL_NEEDLESS_WITHIN`]: that one, or its rival built coarse to
+/// fine (`sphere_map.rs`).
 #[derive(Clone, Copy, Debug)]
 pub struct SphereChoice {
     /// The largest residual at the mesh's vertices of the fit through each (model units).

@@ -474,7 +474,7 @@ impl SphereChoiceReport {
             self.max_residual_conformal,
         );
         let (kept, residual, other, other_residual) = if self.kept_coarse_to_fine {
-            let other = "through the conformal map's, which still squeezed part of the mesh";
+            let other = "through the conformal map's";
             ("built coarse to fine", built, other, conformal)
         } else {
             (
@@ -804,7 +804,7 @@ mod tests {
         assert_eq!(
             built.to_text(),
             "map: built coarse to fine (its fit's largest residual 1.420% of the diagonal, \
-             10.900% through the conformal map's, which still squeezed part of the mesh)\n"
+             10.900% through the conformal map's)\n"
         );
         let conformal = SphereChoiceReport {
             max_residual_conformal: 0.00486,
